@@ -1,0 +1,240 @@
+// Forward-difference evaluation of cubic curves and bicubic patches.
+//
+// Set-up (Prepare*) forms the difference matrix DD = E(δ)·C·E(ε)ᵀ exactly in
+// integers and rounds it once to the format the precision planner chose;
+// stepping (the Stepper classes) then costs only additions:
+// row1 += row2, row2 += row3, row3 += row4.
+//
+// The promise, proven in docs/precision.md and checked by tests/: every
+// position a stepper emits is within 0.51 quanta of the exact curve or patch
+// defined by the geometry the caller passed (geometry already in quanta with
+// kGeometryFracBits guard bits, and an extra ≤ 0.002 quanta for the caller's
+// rounding into that format). A request the engine cannot serve within that
+// bound is refused by Prepare*, never stepped wrongly.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fdsurf/basis.h"
+#include "fdsurf/fixed.h"
+#include "fdsurf/int128.h"
+#include "fdsurf/status.h"
+
+namespace fdsurf {
+
+/// Largest step count per direction of a patch grid.
+constexpr uint16_t kMaxPatchSteps = 1024;
+/// Largest step count of a curve.
+constexpr uint16_t kMaxCurveSteps = 65535;
+/// Fractional bits kept beyond those that make the accumulated rounding of
+/// the difference table exactly ≤ 1 quantum; 9 makes it ≤ 2^-10 quanta.
+constexpr int kGuardBits = 9;
+
+/// The runtime format of the differences: accumulator width and the number of
+/// fractional bits (values are integers in units of 2^-frac_bits quanta).
+struct DiffFormat {
+  uint8_t acc_bits;   // 64 or 128
+  uint8_t frac_bits;  // F
+};
+
+/// What callers may limit or (in tests only) weaken.
+struct PrepareOptions {
+  /// 64 refuses work that needs the wider accumulator (e.g. to keep an AVR
+  /// build on 64-bit adds); 128 allows both.
+  uint8_t max_acc_bits = 128;
+  /// Removes fractional bits from the planned format. Exists so tests can show
+  /// that the bound fails without them; production code leaves it at 0.
+  uint8_t test_only_frac_bits_removed = 0;
+};
+
+/// One coordinate of a curve's geometry: the 4 basis coefficients
+/// (Hermite: P0, P1, T0, T1; Bézier: 4 control points; power: a, b, c, d).
+struct CurveGeometry1 {
+  GeometryFixed g[4];
+};
+
+/// One coordinate of a patch's geometry matrix G (first index along s).
+struct PatchGeometry1 {
+  GeometryFixed g[4][4];
+};
+
+/// A curve ready to step: its difference vectors in the planned format.
+template <int kDims>
+struct PreparedCurve {
+  DiffFormat format;
+  uint16_t steps;
+  /// True when every difference was represented without rounding, so the
+  /// stepping adds no error at all (power-of-two steps with enough bits).
+  bool exact;
+  Int128 d[kDims][4];
+};
+
+/// A patch ready to step: per coordinate the 4×4 difference matrix DD; row k
+/// holds the k-th s-difference, column l the l-th t-difference.
+template <int kDims>
+struct PreparedPatch {
+  DiffFormat format;
+  uint16_t steps_s;
+  uint16_t steps_t;
+  bool exact;
+  Int128 dd[kDims][4][4];
+};
+
+/// The fractional bits that make the stepping error ≤ 2^-(kGuardBits+1)
+/// quanta for `steps_s` × `steps_t` steps (steps_t = 0 for a curve).
+int RequiredFracBits(uint32_t steps_s, uint32_t steps_t);
+
+/// Plans and sets up one curve coordinate by coordinate.
+/// Errors: kInvalidArgument (unknown basis, kDims out of 1..3),
+/// kGridOutOfRange (steps outside 1..kMaxCurveSteps), kGeometryOutOfRange,
+/// kPrecisionUnreachable. On error *out is unchanged.
+template <int kDims>
+Status PrepareCurve(const CurveGeometry1 (&geometry)[kDims], Basis basis, uint16_t steps,
+                    const PrepareOptions& options, PreparedCurve<kDims>* out);
+
+/// Plans and sets up one patch: a grid of steps_s × steps_t steps
+/// (steps_s + 1 by steps_t + 1 points). Errors as PrepareCurve, with
+/// kGridOutOfRange for a step count outside 1..kMaxPatchSteps.
+template <int kDims>
+Status PreparePatch(const PatchGeometry1 (&geometry)[kDims], Basis basis, uint16_t steps_s,
+                    uint16_t steps_t, const PrepareOptions& options, PreparedPatch<kDims>* out);
+
+namespace internal {
+
+inline void Load(const Int128& from, int64_t* to) {
+  // The planner proved the value fits, so the low limb is the value.
+  *to = static_cast<int64_t>(from.lo);
+}
+inline void Load(const Int128& from, Int128* to) { *to = from; }
+
+/// The row-add update of one difference vector: advance one step.
+template <typename Acc>
+inline void Step(Acc* d) {
+  d[0] += d[1];
+  d[1] += d[2];
+  d[2] += d[3];
+}
+
+}  // namespace internal
+
+/// Steps a prepared curve with accumulator Acc (int64_t or Int128; int64_t
+/// only when format.acc_bits == 64). Sink is called as sink(i, point) with
+/// point an `const int32_t (&)[kDims]` in quanta, for i = 0..steps.
+template <typename Acc, int kDims>
+class CurveStepper {
+ public:
+  explicit CurveStepper(const PreparedCurve<kDims>& curve)
+      : frac_bits_(curve.format.frac_bits), steps_(curve.steps) {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+    }
+  }
+
+  template <typename Sink>
+  void ForEachPoint(Sink&& sink) const {
+    Acc d[kDims][4];
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) d[c][k] = d_[c][k];
+    }
+    int32_t point[kDims];
+    for (uint32_t i = 0;; ++i) {
+      for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(d[c][0], frac_bits_);
+      sink(i, point);
+      if (i == steps_) break;
+      for (int c = 0; c < kDims; ++c) internal::Step(d[c]);
+    }
+  }
+
+ private:
+  Acc d_[kDims][4];
+  int frac_bits_;
+  uint16_t steps_;
+};
+
+/// Steps a prepared patch with accumulator Acc (see CurveStepper).
+template <typename Acc, int kDims>
+class PatchStepper {
+ public:
+  explicit PatchStepper(const PreparedPatch<kDims>& patch)
+      : frac_bits_(patch.format.frac_bits), steps_s_(patch.steps_s), steps_t_(patch.steps_t) {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) {
+        for (int l = 0; l < 4; ++l) internal::Load(patch.dd[c][k][l], &dd_[c][k][l]);
+      }
+    }
+  }
+
+  /// s-lines (t varies along each): sink(i, j, point) for i = 0..steps_s, and
+  /// within each i, j = 0..steps_t. This is also the full grid, i-major.
+  /// Row 0 of DD is the t-difference vector of the s-line at s_i; stepping s
+  /// is the row-add update applied to the columns of DD.
+  template <typename Sink>
+  void ForEachSLinePoint(Sink&& sink) const {
+    Acc dd[kDims][4][4];
+    Copy(dd);
+    Acc line[kDims][4];
+    int32_t point[kDims];
+    for (uint32_t i = 0;; ++i) {
+      for (int c = 0; c < kDims; ++c) {
+        for (int l = 0; l < 4; ++l) line[c][l] = dd[c][0][l];
+      }
+      for (uint32_t j = 0;; ++j) {
+        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], frac_bits_);
+        sink(i, j, point);
+        if (j == steps_t_) break;
+        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      }
+      if (i == steps_s_) break;
+      for (int c = 0; c < kDims; ++c) {
+        for (int l = 0; l < 4; ++l) {
+          dd[c][0][l] += dd[c][1][l];
+          dd[c][1][l] += dd[c][2][l];
+          dd[c][2][l] += dd[c][3][l];
+        }
+      }
+    }
+  }
+
+  /// t-lines (s varies along each): sink(i, j, point) for j = 0..steps_t, and
+  /// within each j, i = 0..steps_s. The transposed stepping: column 0 of DD
+  /// is the s-difference vector of the t-line at t_j.
+  template <typename Sink>
+  void ForEachTLinePoint(Sink&& sink) const {
+    Acc dd[kDims][4][4];
+    Copy(dd);
+    Acc line[kDims][4];
+    int32_t point[kDims];
+    for (uint32_t j = 0;; ++j) {
+      for (int c = 0; c < kDims; ++c) {
+        for (int k = 0; k < 4; ++k) line[c][k] = dd[c][k][0];
+      }
+      for (uint32_t i = 0;; ++i) {
+        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], frac_bits_);
+        sink(i, j, point);
+        if (i == steps_s_) break;
+        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      }
+      if (j == steps_t_) break;
+      for (int c = 0; c < kDims; ++c) {
+        for (int k = 0; k < 4; ++k) internal::Step(dd[c][k]);
+      }
+    }
+  }
+
+ private:
+  void Copy(Acc (&to)[kDims][4][4]) const {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) {
+        for (int l = 0; l < 4; ++l) to[c][k][l] = dd_[c][k][l];
+      }
+    }
+  }
+
+  Acc dd_[kDims][4][4];
+  int frac_bits_;
+  uint16_t steps_s_;
+  uint16_t steps_t_;
+};
+
+}  // namespace fdsurf

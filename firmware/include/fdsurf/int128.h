@@ -1,0 +1,70 @@
+// The accumulator types of the stepping loop.
+//
+// Differences are held as integers in units of 2^-F quanta (F chosen by the
+// precision planner) in either a native int64_t or in Int128, a portable pair
+// of 64-bit limbs. Both only ever add in the hot loop; because the arithmetic
+// is exact integer addition, every target produces the same bits.
+#pragma once
+
+#include <stdint.h>
+
+namespace fdsurf {
+
+/// A 128-bit two's complement integer that supports the few operations the
+/// stepping loop needs. Written out rather than relying on __int128, which
+/// 32-bit and 8-bit targets lack.
+struct Int128 {
+  uint64_t lo;
+  uint64_t hi;  // Two's complement: the sign is bit 63 of hi.
+
+  Int128& operator+=(const Int128& other) {
+    const uint64_t lo_sum = lo + other.lo;
+    hi += other.hi + (lo_sum < lo ? 1u : 0u);
+    lo = lo_sum;
+    return *this;
+  }
+
+  friend bool operator==(const Int128& a, const Int128& b) { return a.lo == b.lo && a.hi == b.hi; }
+};
+
+namespace internal {
+
+/// Two's complement reinterpretation, well defined for every value.
+inline int32_t ToInt32(uint32_t bits) {
+  return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits)
+                             : -static_cast<int32_t>(~bits) - 1;
+}
+
+}  // namespace internal
+
+/// Rounds value / 2^frac_bits to the nearest integer (halves upward).
+/// Requires 1 <= frac_bits <= 62 and a result that fits in int32_t, which the
+/// precision planner guarantees.
+inline int32_t RoundToQuanta(int64_t value, int frac_bits) {
+  const uint64_t biased = static_cast<uint64_t>(value) + (uint64_t{1} << (frac_bits - 1));
+  // Arithmetic shift written with unsigned operations: floor(x / 2^F) of a
+  // negative x is ~(~x >> F).
+  const uint64_t shifted = (biased >> 63) != 0 ? ~(~biased >> frac_bits) : biased >> frac_bits;
+  return internal::ToInt32(static_cast<uint32_t>(shifted));
+}
+
+/// As above for Int128; 1 <= frac_bits <= 126.
+inline int32_t RoundToQuanta(const Int128& value, int frac_bits) {
+  Int128 biased = value;
+  const Int128 half = frac_bits > 64 ? Int128{0, uint64_t{1} << (frac_bits - 65)}
+                                     : Int128{uint64_t{1} << (frac_bits - 1), 0};
+  biased += half;
+  const bool negative = (biased.hi >> 63) != 0;
+  uint64_t low_word;  // Bits frac_bits .. frac_bits + 63 of the sum.
+  if (frac_bits < 64) {
+    low_word = (biased.lo >> frac_bits) | (biased.hi << (64 - frac_bits));
+  } else if (frac_bits == 64) {
+    low_word = biased.hi;
+  } else {
+    const int shift = frac_bits - 64;
+    low_word = negative ? ~(~biased.hi >> shift) : biased.hi >> shift;
+  }
+  return internal::ToInt32(static_cast<uint32_t>(low_word));
+}
+
+}  // namespace fdsurf

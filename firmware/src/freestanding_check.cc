@@ -1,0 +1,34 @@
+// Instantiates every stepper template under the core's freestanding flags, so
+// that header-only code is held to the same rules as the .cc files.
+#include "fdsurf/forward_difference.h"
+
+namespace fdsurf {
+
+template class CurveStepper<int64_t, 1>;
+template class CurveStepper<int64_t, 2>;
+template class CurveStepper<int64_t, 3>;
+template class CurveStepper<Int128, 1>;
+template class CurveStepper<Int128, 2>;
+template class CurveStepper<Int128, 3>;
+template class PatchStepper<int64_t, 2>;
+template class PatchStepper<int64_t, 3>;
+template class PatchStepper<Int128, 2>;
+template class PatchStepper<Int128, 3>;
+
+namespace {
+struct CountingSink {
+  uint32_t count;
+  template <int kDims>
+  void operator()(uint32_t, uint32_t, const int32_t (&)[kDims]) { ++count; }
+};
+}  // namespace
+
+// Not called; forces the member templates to compile freestanding too.
+uint32_t FreestandingCheckCountPoints(const PreparedPatch<3>& patch) {
+  CountingSink sink{0};
+  PatchStepper<Int128, 3>(patch).ForEachSLinePoint(sink);
+  PatchStepper<int64_t, 3>(patch).ForEachTLinePoint(sink);
+  return sink.count;
+}
+
+}  // namespace fdsurf

@@ -1,0 +1,21 @@
+#include "fdsurf/status.h"
+
+namespace fdsurf {
+
+const char* StatusMessage(Status status) {
+  switch (status) {
+    case Status::kOk:
+      return "ok";
+    case Status::kInvalidArgument:
+      return "invalid argument";
+    case Status::kGridOutOfRange:
+      return "grid out of range";
+    case Status::kGeometryOutOfRange:
+      return "geometry out of range";
+    case Status::kPrecisionUnreachable:
+      return "precision unreachable";
+  }
+  return "unknown status";
+}
+
+}  // namespace fdsurf

@@ -1,0 +1,56 @@
+// Host glue for the fixed-point engine: converts a double-precision patch to
+// the engine's geometry format for a quantum, plans it, and steps it with the
+// accumulator width the plan chose.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "fdsurf/forward_difference.h"
+#include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/quantum.h"
+
+namespace fdsurf::host {
+
+/// The engine refused a patch; the message says which and why.
+class EngineError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Converts `patch` into quanta with kGeometryFracBits guard bits and prepares
+/// it for a steps_s × steps_t grid. Throws EngineError (naming patch.origin)
+/// when a coordinate is not finite or too large, or the engine cannot serve
+/// the grid within the bound.
+PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, int steps_s,
+                                   int steps_t, const PrepareOptions& options = {});
+
+/// Steps a prepared patch along s-lines (the grid, i-major), picking the
+/// accumulator the plan chose. sink(i, j, const int32_t (&)[3]).
+template <typename Sink>
+void ForEachGridPoint(const PreparedPatch<3>& patch, Sink&& sink) {
+  if (patch.format.acc_bits == 64) {
+    PatchStepper<std::int64_t, 3>(patch).ForEachSLinePoint(sink);
+  } else {
+    PatchStepper<Int128, 3>(patch).ForEachSLinePoint(sink);
+  }
+}
+
+/// As above along t-lines.
+template <typename Sink>
+void ForEachTLinePoint(const PreparedPatch<3>& patch, Sink&& sink) {
+  if (patch.format.acc_bits == 64) {
+    PatchStepper<std::int64_t, 3>(patch).ForEachTLinePoint(sink);
+  } else {
+    PatchStepper<Int128, 3>(patch).ForEachTLinePoint(sink);
+  }
+}
+
+/// A rigorous a-priori bound (in quanta) of |fixed − exact| before the final
+/// rounding to whole quanta, for this basis and grid: the stepping term
+/// S(n)·S(m)·2^-(F+1) plus the geometry conversion term L·(2^-17 + 2^-20)
+/// (docs/precision.md). The emitted positions are within 0.5 + this.
+double ErrorBoundBeforeRounding(const PreparedPatch<3>& patch, Basis basis);
+
+}  // namespace fdsurf::host

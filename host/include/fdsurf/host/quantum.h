@@ -1,0 +1,33 @@
+// The output quantum Q: a positive decimal, kept exact so positions can be
+// printed as their exact decimal value k·Q.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace fdsurf::host {
+
+class Quantum {
+ public:
+  /// Parses "0.001", "0.025", "1", "2.5". At most 9 significant digits and 9
+  /// decimals; throws InputError naming `what` otherwise.
+  static Quantum Parse(const std::string& text, const std::string& what = "--quantum");
+
+  /// Q = mantissa · 10^-decimals.
+  std::int64_t mantissa() const { return mantissa_; }
+  int decimals() const { return decimals_; }
+  double value() const;
+
+  /// value / Q as a double, with about 2^-52 relative error (one rounding
+  /// for the product, one for the quotient).
+  double ToQuanta(double value) const;
+
+  /// The exact decimal text of k·Q ("-1.400" for k = -1400, Q = 0.001).
+  std::string Format(std::int64_t k) const;
+
+ private:
+  std::int64_t mantissa_ = 1;
+  int decimals_ = 3;
+};
+
+}  // namespace fdsurf::host
