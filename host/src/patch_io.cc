@@ -25,7 +25,9 @@ class BptTokens {
       if (text_[pos_] == '\n') ++line_;
       ++pos_;
     }
-    token_line_ = line_;
+    // At the end of the text, report the line of the last token: an editor
+    // shows no line after a final newline.
+    if (pos_ < text_.size()) token_line_ = line_;
     const std::size_t start = pos_;
     while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
     return std::string_view(text_).substr(start, pos_ - start);
@@ -264,6 +266,12 @@ PatchSet ParseJson(const std::string& text, const std::string& name) {
     if (colon != std::string::npos) what = what.substr(colon + 2);
     throw InputError(name + ":" + LineAndColumn(text, e.byte > 0 ? e.byte - 1 : 0) +
                      ": invalid JSON: " + what);
+  } catch (const nlohmann::json::exception& e) {
+    // E.g. "number overflow parsing '1e400'": nlohmann gives no position.
+    std::string what = e.what();
+    const std::size_t bracket = what.find("] ");
+    if (bracket != std::string::npos) what = what.substr(bracket + 2);
+    throw InputError(name + ": invalid JSON: " + what);
   }
   const JsonPlace root{name, ""};
   if (!doc.is_object()) throw root.Error("the top level must be an object");

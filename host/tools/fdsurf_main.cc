@@ -196,6 +196,13 @@ int main(int argc, char** argv) {
       "check", "Compare the fixed engine with the double reference on every grid point.");
   AddCommonOptions(check, &check_options);
 
+  // CLI11 would only say "a subcommand is required" for a mistyped command.
+  if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "sample" &&
+      std::string(argv[1]) != "check") {
+    std::fprintf(stderr, "fdsurf: error: unknown command '%s' (expected sample or check)\n",
+                 argv[1]);
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

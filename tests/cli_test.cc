@@ -1,0 +1,192 @@
+// The fdsurf tool as a user runs it: output on success, and on bad input a
+// message on stderr naming the file and place, a non-zero exit, empty stdout.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/reference.h"
+
+namespace fdsurf::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("fdsurf_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  RunResult Run(const std::string& args) {
+    const fs::path out = dir_ / "stdout";
+    const fs::path err = dir_ / "stderr";
+    const std::string command = std::string("'") + FDSURF_BINARY + "' " + args + " >'" +
+                                out.string() + "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+  }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path) << text;
+    return path.string();
+  }
+
+  // Asserts the contract for bad input.
+  void ExpectRefused(const std::string& args, const std::string& stderr_part) {
+    const RunResult r = Run(args);
+    EXPECT_NE(r.exit_code, 0) << args;
+    EXPECT_EQ(r.out, "") << args;
+    EXPECT_NE(r.err.find(stderr_part), std::string::npos)
+        << args << "\nstderr: " << r.err << "\nwanted: " << stderr_part;
+  }
+
+  fs::path dir_;
+};
+
+const std::string kTeapot = FDSURF_EXAMPLES_DIR "/teapot.bpt";
+
+std::vector<std::vector<std::string>> ParseCsv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    std::vector<std::string> fields;
+    std::istringstream cells(line);
+    std::string cell;
+    while (std::getline(cells, cell, ',')) fields.push_back(cell);
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+TEST_F(Cli, SampleFixedPrintsExactMultiplesOfTheQuantumWithinTheBound) {
+  const RunResult r = Run("sample '" + kTeapot + "' --grid 3x2 --quantum 0.005");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto rows = ParseCsv(r.out);
+  ASSERT_EQ(rows.size(), 1u + 32u * 4u * 3u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"patch", "i", "j", "x", "y", "z"}));
+  const PatchSet set = ReadPatchFile(kTeapot);
+  for (std::size_t r_index = 1; r_index < rows.size(); ++r_index) {
+    const auto& row = rows[r_index];
+    ASSERT_EQ(row.size(), 6u);
+    const int patch = std::stoi(row[0]);
+    const int i = std::stoi(row[1]);
+    const int j = std::stoi(row[2]);
+    const Point3 exact = EvaluateReference(set.patches[patch], i / 3.0, j / 2.0);
+    for (int c = 0; c < 3; ++c) {
+      const std::string& text = row[3 + c];
+      // Exact decimal with three places, a multiple of 0.005.
+      ASSERT_EQ(text.size() - text.find('.'), 4u) << text;
+      const long thousandths = std::lround(std::stod(text) * 1000);
+      EXPECT_EQ(thousandths % 5, 0) << text;
+      EXPECT_LE(std::fabs(std::stod(text) - exact[c]), 0.51 * 0.005 + 1e-12) << text;
+    }
+  }
+}
+
+TEST_F(Cli, SampleDoublePrintsTheReference) {
+  const RunResult r = Run("sample '" + kTeapot + "' --grid 2 --engine double");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = ParseCsv(r.out);
+  ASSERT_EQ(rows.size(), 1u + 32u * 9u);
+  const PatchSet set = ReadPatchFile(kTeapot);
+  const Point3 exact = EvaluateReference(set.patches[5], 0.5, 1.0);
+  const auto& row = rows[1 + 5 * 9 + 1 * 3 + 2];
+  ASSERT_EQ(row[0], "5");
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(std::stod(row[3 + c]), exact[c]);
+}
+
+TEST_F(Cli, SampleReadsJson) {
+  const std::string file = Write(
+      "net.json",
+      R"({"units": "mm", "surfaces": [{"basis": "catmull-rom", "net": [
+        [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,0,0]],
+        [[0,1,0],[1,1,1],[2,1,2],[3,1,1],[4,1,0]],
+        [[0,2,0],[1,2,1],[2,2,3],[3,2,1],[4,2,0]],
+        [[0,3,0],[1,3,0],[2,3,0],[3,3,0],[4,3,0]]]}]})");
+  const RunResult r = Run("sample '" + file + "' --grid 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Two patches (4×5 net), and Catmull-Rom passes through net[1][1] at (0,0).
+  const auto rows = ParseCsv(r.out);
+  ASSERT_EQ(rows.size(), 1u + 2u * 4u);
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"0", "0", "0", "1.000", "1.000", "1.000"}));
+  EXPECT_EQ(rows[8], (std::vector<std::string>{"1", "1", "1", "3.000", "2.000", "1.000"}));
+}
+
+TEST_F(Cli, CheckReportsTheWorstErrorAndPasses) {
+  const RunResult r = Run("check '" + kTeapot + "' --grid 20x30");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("within the 0.51-quantum bound"), std::string::npos) << r.out;
+  const std::size_t at = r.out.find("overall: max error ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const double worst = std::stod(r.out.substr(at + 19));
+  EXPECT_GT(worst, 0.3);  // rounding to whole quanta alone errs by up to 0.5
+  EXPECT_LE(worst, 0.51);
+}
+
+TEST_F(Cli, HelpOnTheToolAndEachCommand) {
+  for (const std::string args : {"--help", "sample --help", "check --help"}) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.exit_code, 0) << args;
+    EXPECT_NE(r.out.find("--"), std::string::npos) << args;
+  }
+  EXPECT_NE(Run("sample --help").out.find("--engine"), std::string::npos);
+}
+
+TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
+  ExpectRefused("sample /nonexistent.bpt --grid 4", "/nonexistent.bpt: cannot open");
+  ExpectRefused("sample '" + kTeapot + "' --grid 0", "--grid: '0' is out of range");
+  ExpectRefused("sample '" + kTeapot + "' --grid 1025", "between 1 and 1024");
+  ExpectRefused("sample '" + kTeapot + "' --grid 4xq", "--grid: '4xq' is not N or NxM");
+  ExpectRefused("sample '" + kTeapot + "'", "--grid is required");
+  ExpectRefused("sample '" + kTeapot + "' --grid 4 --quantum -1", "--quantum: '-1'");
+  ExpectRefused("sample '" + kTeapot + "' --grid 4 --engine float", "--engine");
+  ExpectRefused("sample '" + kTeapot + "' --grid 4 --frobnicate", "frobnicate");
+  ExpectRefused("bake '" + kTeapot + "'", "unknown command 'bake' (expected sample or check)");
+  ExpectRefused("check '" + kTeapot + "' --grid 4 --quantum 0.000000001",
+                "teapot.bpt:2 (patch 0): geometry [0][0].z = 2.4 is out of range");
+
+  const std::string truncated = Write("t.bpt", "2\n3 3\n0 0 0\n");
+  ExpectRefused("sample '" + truncated + "' --grid 4", "t.bpt:3: file ends where x was expected");
+  const std::string garbled = Write("g.bpt", "1\n3 3\n0 0 0\n1 O 0\n");
+  ExpectRefused("sample '" + garbled + "' --grid 4", "g.bpt:4: y 'O' is not a number");
+  const std::string basis = Write("b.json", R"({"surfaces": [{"basis": "nurbs", "net": []}]})");
+  ExpectRefused("sample '" + basis + "' --grid 4", "b.json: surfaces[0].basis: unknown basis");
+  const std::string counts =
+      Write("c.json", R"({"surfaces": [{"basis": "bezier", "net": [[[0,0,0],[1,1,1]]]}]})");
+  ExpectRefused("sample '" + counts + "' --grid 4",
+                "c.json: surfaces[0].net: a bezier net must be (3m+1)x(3n+1) points, got 1x2");
+  const std::string broken = Write("d.json", "{\"surfaces\": [\n{]}");
+  ExpectRefused("sample '" + broken + "' --grid 4", "d.json:2:2: invalid JSON");
+  const std::string empty = Write("e.bpt", "  \n");
+  ExpectRefused("sample '" + empty + "' --grid 4", "e.bpt:1: file ends where the number");
+}
+
+}  // namespace
+}  // namespace fdsurf::host

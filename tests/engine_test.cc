@@ -1,0 +1,349 @@
+// The fixed-point engine against the exact rational reference
+// (exact_reference.h): every emitted point within 0.51 quanta, for every
+// basis, many grids, and geometry at the edge of the supported range.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "exact_reference.h"
+#include "fdsurf/forward_difference.h"
+
+namespace fdsurf {
+namespace {
+
+using testing::ExactCurvePoint;
+using testing::ExactPatchPoint;
+using testing::I128;
+using testing::IsRoundedValue;
+using testing::Rational;
+using testing::WithinBound;
+
+constexpr std::int64_t kOneQuantumRaw = std::int64_t{1} << kGeometryFracBits;
+const Basis kAllBases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline,
+                           Basis::kCatmullRom};
+
+// Raw geometry (units of 2^-16 quanta) of one patch, per coordinate.
+struct RawPatch {
+  std::int64_t g[3][4][4];
+};
+
+// Random geometry whose surface stays within about ±range quanta: power
+// coefficients are scaled down so that their sum stays in range, Hermite
+// tangents may be a few times larger than the points (as real tangents are).
+RawPatch RandomPatch(std::mt19937_64& rng, Basis basis, double range_quanta) {
+  RawPatch patch;
+  for (int c = 0; c < 3; ++c) {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        double limit = range_quanta;
+        if (basis == Basis::kPower) limit /= 16;
+        if (basis == Basis::kHermite && (i >= 2 || j >= 2)) limit *= 2;
+        std::uniform_real_distribution<double> dist(-limit, limit);
+        patch.g[c][i][j] = static_cast<std::int64_t>(dist(rng) * kOneQuantumRaw);
+      }
+    }
+  }
+  return patch;
+}
+
+Rational ExactPoint(Basis basis, const std::int64_t (&g)[4][4], int i, int n, int j, int m) {
+  Rational x = ExactPatchPoint(static_cast<int>(basis), g, i, n, j, m);
+  x.denominator *= kOneQuantumRaw;  // geometry carries 16 fractional bits
+  return x;
+}
+
+Status Prepare(const RawPatch& raw, Basis basis, int n, int m, PreparedPatch<3>* out,
+               PrepareOptions options = {}) {
+  PatchGeometry1 geometry[3];
+  for (int c = 0; c < 3; ++c) {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) geometry[c].g[i][j] = GeometryFixed::FromRaw(raw.g[c][i][j]);
+    }
+  }
+  return PreparePatch(geometry, basis, static_cast<std::uint16_t>(n),
+                      static_cast<std::uint16_t>(m), options, out);
+}
+
+struct GridPoints {
+  int n;
+  int m;
+  std::vector<std::int32_t> xyz;  // 3 per point, i-major
+  void Put(std::uint32_t i, std::uint32_t j, const std::int32_t (&p)[3]) {
+    const std::size_t at = 3 * (static_cast<std::size_t>(i) * (m + 1) + j);
+    for (int c = 0; c < 3; ++c) xyz[at + c] = p[c];
+  }
+};
+
+template <typename Acc>
+void Step(const PreparedPatch<3>& prepared, GridPoints* s_lines, GridPoints* t_lines) {
+  std::size_t count = 0;
+  PatchStepper<Acc, 3>(prepared).ForEachSLinePoint(
+      [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&p)[3]) {
+        s_lines->Put(i, j, p);
+        ++count;
+      });
+  PatchStepper<Acc, 3>(prepared).ForEachTLinePoint(
+      [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&p)[3]) {
+        t_lines->Put(i, j, p);
+        ++count;
+      });
+  EXPECT_EQ(count, 2 * static_cast<std::size_t>(s_lines->n + 1) * (s_lines->m + 1));
+}
+
+// Steps the patch both ways and checks every point against the exact value.
+// Returns the number of points that broke the bound.
+int CheckPatch(const RawPatch& raw, Basis basis, int n, int m, PrepareOptions options = {},
+               bool expect_rounded = false) {
+  PreparedPatch<3> prepared;
+  const Status status = Prepare(raw, basis, n, m, &prepared, options);
+  EXPECT_EQ(status, Status::kOk) << StatusMessage(status);
+  if (status != Status::kOk) return 1;
+  const std::size_t points = static_cast<std::size_t>(n + 1) * (m + 1);
+  GridPoints s_lines{n, m, std::vector<std::int32_t>(3 * points)};
+  GridPoints t_lines{n, m, std::vector<std::int32_t>(3 * points)};
+  if (prepared.format.acc_bits == 64) {
+    Step<std::int64_t>(prepared, &s_lines, &t_lines);
+  } else {
+    Step<Int128>(prepared, &s_lines, &t_lines);
+  }
+  // Both families visit the same sum of the same integers at (i, j).
+  EXPECT_EQ(s_lines.xyz, t_lines.xyz) << "s-lines and t-lines disagree";
+  int violations = 0;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= m; ++j) {
+      for (int c = 0; c < 3; ++c) {
+        const std::int32_t k = s_lines.xyz[3 * (static_cast<std::size_t>(i) * (m + 1) + j) + c];
+        const Rational exact = ExactPoint(basis, raw.g[c], i, n, j, m);
+        if (!WithinBound(k, exact)) {
+          if (++violations <= 3 && options.test_only_frac_bits_removed == 0) {
+            ADD_FAILURE() << BasisName(basis) << " " << n << "x" << m << " point (" << i << ","
+                          << j << ") coordinate " << c << ": got " << k << ", exact "
+                          << testing::ToDouble(exact);
+          }
+        }
+        if (expect_rounded) {
+          EXPECT_TRUE(IsRoundedValue(k, exact)) << "(" << i << "," << j << ") " << c;
+        }
+      }
+    }
+  }
+  return violations;
+}
+
+TEST(PatchEngine, RandomPatchesOfEveryBasisOnManyGrids) {
+  std::mt19937_64 rng(20261122);
+  const int grids[][2] = {{1, 1},  {1, 7},   {2, 3},   {3, 3},   {5, 8},  {7, 13},
+                          {16, 16}, {10, 100}, {33, 64}, {100, 1}, {63, 65}, {127, 3}};
+  for (Basis basis : kAllBases) {
+    for (const auto& grid : grids) {
+      for (int trial = 0; trial < 6; ++trial) {
+        const RawPatch patch = RandomPatch(rng, basis, 1 << 16);
+        EXPECT_EQ(CheckPatch(patch, basis, grid[0], grid[1]), 0);
+      }
+    }
+  }
+}
+
+TEST(PatchEngine, LargestGridsAtTheEdgeOfTheRange) {
+  std::mt19937_64 rng(7);
+  const int grids[][2] = {{1024, 1024}, {1023, 1021}, {1024, 3}, {997, 1024}};
+  for (Basis basis : kAllBases) {
+    for (const auto& grid : grids) {
+      const RawPatch patch = RandomPatch(rng, basis, 1 << 20);
+      EXPECT_EQ(CheckPatch(patch, basis, grid[0], grid[1]), 0);
+    }
+  }
+}
+
+TEST(PatchEngine, ExtremeControlPointsAtPlusMinusTwoToTheTwenty) {
+  // Alternating ±2^20 quanta: the largest differences a Bézier or B-spline
+  // net of that range can produce.
+  for (Basis basis : {Basis::kBezier, Basis::kBSpline, Basis::kCatmullRom}) {
+    RawPatch patch;
+    for (int c = 0; c < 3; ++c) {
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+          const int sign = ((i + j + c) % 2 == 0) ? 1 : -1;
+          patch.g[c][i][j] = sign * (std::int64_t{1} << 20) * kOneQuantumRaw;
+        }
+      }
+    }
+    EXPECT_EQ(CheckPatch(patch, basis, 1024, 1024), 0);
+    EXPECT_EQ(CheckPatch(patch, basis, 1, 1), 0);
+    EXPECT_EQ(CheckPatch(patch, basis, 3, 1000), 0);
+  }
+}
+
+TEST(PatchEngine, PowerOfTwoGridsWithWholeQuantaAreExact) {
+  // Integer-matrix bases, whole-quantum geometry, power-of-two steps: the
+  // table is exact, so every point is the correctly rounded exact value.
+  std::mt19937_64 rng(3);
+  for (Basis basis : {Basis::kBezier, Basis::kHermite, Basis::kPower}) {
+    for (int n : {1, 2, 8, 64, 256}) {
+      RawPatch patch = RandomPatch(rng, basis, 1 << 18);
+      for (auto& plane : patch.g) {
+        for (auto& row : plane) {
+          for (auto& v : row) v = (v / kOneQuantumRaw) * kOneQuantumRaw;
+        }
+      }
+      PreparedPatch<3> prepared;
+      ASSERT_EQ(Prepare(patch, basis, n, n, &prepared), Status::kOk);
+      EXPECT_TRUE(prepared.exact) << BasisName(basis) << " " << n;
+      EXPECT_EQ(CheckPatch(patch, basis, n, n, {}, /*expect_rounded=*/true), 0);
+    }
+  }
+}
+
+TEST(PatchEngine, NonDyadicStepsAreNotExact) {
+  std::mt19937_64 rng(5);
+  const RawPatch patch = RandomPatch(rng, Basis::kBezier, 1000);
+  PreparedPatch<3> prepared;
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 3, 3, &prepared), Status::kOk);
+  EXPECT_FALSE(prepared.exact);
+}
+
+TEST(PatchEngine, TheBoundFailsWithoutThePlannedFractionalBits) {
+  // The tests above would catch a planner that kept too few bits: with 16
+  // bits fewer, a 1024×1024 B-spline patch (non-dyadic 1/6) breaks the bound.
+  std::mt19937_64 rng(11);
+  const RawPatch patch = RandomPatch(rng, Basis::kBSpline, 1 << 20);
+  PrepareOptions weakened;
+  weakened.test_only_frac_bits_removed = 16;
+  EXPECT_GT(CheckPatch(patch, Basis::kBSpline, 1024, 1024, weakened), 0);
+}
+
+TEST(PatchEngine, ChoosesTheNarrowestAccumulator) {
+  std::mt19937_64 rng(13);
+  const RawPatch patch = RandomPatch(rng, Basis::kBezier, 2000);
+  PreparedPatch<3> prepared;
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 64, 64, &prepared), Status::kOk);
+  EXPECT_EQ(prepared.format.acc_bits, 64);
+  EXPECT_EQ(prepared.format.frac_bits, RequiredFracBits(64, 64));
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 1024, 1024, &prepared), Status::kOk);
+  EXPECT_EQ(prepared.format.acc_bits, 128);
+}
+
+TEST(PrecisionPlanner, RequiredFracBitsMatchTheDerivation) {
+  // S(n) = Σ_{k≤3} C(n,k); F = bitlength(S(n)·S(m)) + 9 (docs/precision.md).
+  const auto s = [](std::uint64_t n) {
+    return 1 + n + n * (n - 1) / 2 + n * (n - 1) * (n - 2) / 6;
+  };
+  for (std::uint32_t n : {1u, 2u, 3u, 64u, 100u, 1024u}) {
+    for (std::uint32_t m : {1u, 7u, 1024u}) {
+      const std::uint64_t product = s(n) * s(m);
+      int bits = 0;
+      while ((product >> bits) != 0) ++bits;
+      EXPECT_EQ(RequiredFracBits(n, m), bits + 9);
+      // The stepping error bound 2^-(F+1)·S(n)·S(m) is at most 2^-10 quanta.
+      EXPECT_LE(static_cast<double>(product) / std::ldexp(1.0, RequiredFracBits(n, m) + 1),
+                std::ldexp(1.0, -10));
+    }
+  }
+  EXPECT_EQ(RequiredFracBits(1024, 1024), 64);
+}
+
+TEST(PrecisionPlanner, RefusesWhatItCannotServe) {
+  std::mt19937_64 rng(17);
+  RawPatch patch = RandomPatch(rng, Basis::kBezier, 1000);
+  PreparedPatch<3> prepared;
+  prepared.format = {0, 0};
+  EXPECT_EQ(Prepare(patch, Basis::kBezier, 0, 4, &prepared), Status::kGridOutOfRange);
+  EXPECT_EQ(Prepare(patch, Basis::kBezier, 4, 1025, &prepared), Status::kGridOutOfRange);
+  EXPECT_EQ(Prepare(patch, static_cast<Basis>(9), 4, 4, &prepared), Status::kInvalidArgument);
+
+  // Geometry at 2^31 quanta is outside the geometry format.
+  RawPatch huge = patch;
+  huge.g[1][2][3] = kGeometryLimitRaw;
+  EXPECT_EQ(Prepare(huge, Basis::kBezier, 4, 4, &prepared), Status::kGeometryOutOfRange);
+  huge.g[1][2][3] = -kGeometryLimitRaw;
+  EXPECT_EQ(Prepare(huge, Basis::kBezier, 4, 4, &prepared), Status::kGeometryOutOfRange);
+
+  // Power coefficients inside the format whose sum leaves the int32 output.
+  RawPatch sum = patch;
+  for (auto& row : sum.g[0]) {
+    for (auto& v : row) v = (std::int64_t{1} << 29) * kOneQuantumRaw;
+  }
+  EXPECT_EQ(Prepare(sum, Basis::kPower, 4, 4, &prepared), Status::kGeometryOutOfRange);
+
+  // A caller limited to 64-bit accumulators: a 1024×1024 grid needs F = 64.
+  PrepareOptions narrow;
+  narrow.max_acc_bits = 64;
+  EXPECT_EQ(Prepare(patch, Basis::kBezier, 1024, 1024, &prepared, narrow),
+            Status::kPrecisionUnreachable);
+  // Refusals leave the output untouched.
+  EXPECT_EQ(prepared.format.acc_bits, 0);
+  // The same caller is served on a grid that fits.
+  EXPECT_EQ(Prepare(patch, Basis::kBezier, 64, 64, &prepared, narrow), Status::kOk);
+}
+
+// ---- Curves ------------------------------------------------------------------
+
+TEST(CurveEngine, SeedHermiteExampleFirstSegment) {
+  // Seed 002, example 94: from A(1,1) to B(3,1), start direction v = (0,1),
+  // end direction w = (0,-1). The first segment is x(u) = 1 + 6u² − 4u³ and
+  // y(u) = 1 + u − u². Quantum 0.001: geometry in thousandths.
+  const std::int64_t q = 1000 * kOneQuantumRaw;
+  CurveGeometry1 geometry[2];
+  const std::int64_t x[4] = {1 * q, 3 * q, 0, 0};
+  const std::int64_t y[4] = {1 * q, 1 * q, 1 * q, -1 * q};
+  for (int k = 0; k < 4; ++k) {
+    geometry[0].g[k] = GeometryFixed::FromRaw(x[k]);
+    geometry[1].g[k] = GeometryFixed::FromRaw(y[k]);
+  }
+  for (int n : {4, 10, 1000}) {
+    PreparedCurve<2> curve;
+    ASSERT_EQ(PrepareCurve(geometry, Basis::kHermite, static_cast<std::uint16_t>(n), {}, &curve),
+              Status::kOk);
+    int count = 0;
+    CurveStepper<Int128, 2>(curve).ForEachPoint([&](std::uint32_t i, const std::int32_t (&p)[2]) {
+      // x·1000 at u = i/n, exactly: (1000n³ + 6000·i²·n − 4000·i³) / n³.
+      const I128 n3 = I128(n) * n * n;
+      const Rational exact_x{1000 * n3 + 6000 * I128(i) * i * n - 4000 * I128(i) * i * i, n3};
+      const Rational exact_y{1000 * n3 + 1000 * I128(i) * n * n - 1000 * I128(i) * i * n, n3};
+      EXPECT_TRUE(WithinBound(p[0], exact_x)) << i << "/" << n;
+      EXPECT_TRUE(WithinBound(p[1], exact_y)) << i << "/" << n;
+      ++count;
+    });
+    EXPECT_EQ(count, n + 1);
+  }
+}
+
+TEST(CurveEngine, RandomCurvesOfEveryBasisUpToTheLargestStepCount) {
+  std::mt19937_64 rng(19);
+  for (Basis basis : kAllBases) {
+    for (int n : {1, 2, 3, 10, 1000, 4096, 65535}) {
+      CurveGeometry1 geometry[3];
+      std::int64_t raw[3][4];
+      std::uniform_real_distribution<double> dist(-(1 << 20), 1 << 20);
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 4; ++k) {
+          double v = dist(rng);
+          if (basis == Basis::kPower) v /= 4;
+          raw[c][k] = static_cast<std::int64_t>(v * kOneQuantumRaw);
+          geometry[c].g[k] = GeometryFixed::FromRaw(raw[c][k]);
+        }
+      }
+      PreparedCurve<3> curve;
+      ASSERT_EQ(PrepareCurve(geometry, basis, static_cast<std::uint16_t>(n), {}, &curve),
+                Status::kOk);
+      int bad = 0;
+      const auto check = [&](std::uint32_t i, const std::int32_t (&p)[3]) {
+        for (int c = 0; c < 3; ++c) {
+          Rational exact = ExactCurvePoint(static_cast<int>(basis), raw[c], i, n);
+          exact.denominator *= kOneQuantumRaw;
+          if (!WithinBound(p[c], exact)) ++bad;
+        }
+      };
+      if (curve.format.acc_bits == 64) {
+        CurveStepper<std::int64_t, 3>(curve).ForEachPoint(check);
+      } else {
+        CurveStepper<Int128, 3>(curve).ForEachPoint(check);
+      }
+      EXPECT_EQ(bad, 0) << BasisName(basis) << " n=" << n;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fdsurf
