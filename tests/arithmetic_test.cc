@@ -13,9 +13,7 @@ __extension__ typedef __int128 I128;
 __extension__ typedef unsigned __int128 U128;
 using Wide = internal::WideInt<8>;
 
-I128 ToNative(const Int128& v) {
-  return static_cast<I128>((static_cast<U128>(v.hi) << 64) | v.lo);
-}
+I128 ToNative(const Int128& v) { return static_cast<I128>((static_cast<U128>(v.hi) << 64) | v.lo); }
 Int128 FromNative(I128 v) {
   const auto u = static_cast<U128>(v);
   return Int128{static_cast<std::uint64_t>(u), static_cast<std::uint64_t>(u >> 64)};
@@ -58,8 +56,7 @@ TEST(Int128, RoundToQuantaMatchesNativeForEveryShift) {
       const int bits = std::min(126, f + 30);
       const I128 v = RandomI128(rng, 1 + static_cast<int>(rng() % bits));
       const I128 expected = RoundNative(v, f);
-      ASSERT_EQ(RoundToQuanta(FromNative(v), f), static_cast<std::int32_t>(expected))
-          << "f=" << f;
+      ASSERT_EQ(RoundToQuanta(FromNative(v), f), static_cast<std::int32_t>(expected)) << "f=" << f;
       if (f <= 62 && v > INT64_MIN / 2 && v < INT64_MAX / 2) {
         ASSERT_EQ(RoundToQuanta(static_cast<std::int64_t>(v), f),
                   static_cast<std::int32_t>(expected));
@@ -69,7 +66,7 @@ TEST(Int128, RoundToQuantaMatchesNativeForEveryShift) {
 }
 
 TEST(Int128, RoundsHalvesUpAndNegativesTowardsMinusInfinity) {
-  EXPECT_EQ(RoundToQuanta(std::int64_t{3} << 9, 10), 2);    // 1.5 → 2
+  EXPECT_EQ(RoundToQuanta(std::int64_t{3} << 9, 10), 2);      // 1.5 → 2
   EXPECT_EQ(RoundToQuanta(-(std::int64_t{3} << 9), 10), -1);  // -1.5 → -1
   EXPECT_EQ(RoundToQuanta(-(std::int64_t{5} << 8), 10), -1);  // -1.25 → -1
   EXPECT_EQ(RoundToQuanta(-(std::int64_t{7} << 8), 10), -2);  // -1.75 → -2
@@ -104,7 +101,8 @@ TEST(WideInt, DivideInPlaceMatchesNative) {
   for (int trial = 0; trial < 20000; ++trial) {
     const I128 a = RandomI128(rng, 1 + static_cast<int>(rng() % 126));
     const U128 u = static_cast<U128>(a < 0 ? -a : a);
-    const std::uint32_t divisor = 1 + static_cast<std::uint32_t>(rng() % 65536);
+    const std::uint32_t divisor =
+        1 + static_cast<std::uint32_t>(rng() % ((trial % 2 == 0) ? 65536 : 0xFFFFFFFFu));
     Wide w = Wide::FromInt64(0);
     for (int shift = 96; shift >= 0; shift -= 32) {
       w = w.ShiftedLeft(32) + Wide::FromUint64(static_cast<std::uint32_t>(u >> shift));
@@ -112,6 +110,23 @@ TEST(WideInt, DivideInPlaceMatchesNative) {
     const std::uint32_t remainder = w.DivideInPlace(divisor);
     ASSERT_EQ(static_cast<U128>(Low128(w)), u / divisor);
     ASSERT_EQ(remainder, static_cast<std::uint32_t>(u % divisor));
+  }
+}
+
+TEST(WideInt, ShiftRightAndMulInt64MatchNative) {
+  std::mt19937_64 rng(5);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const I128 a = RandomI128(rng, 1 + static_cast<int>(rng() % 62));
+    const std::int64_t b = static_cast<std::int64_t>(rng()) >> (rng() % 63);
+    const Wide wa = Wide::FromInt64(static_cast<std::int64_t>(a));
+    ASSERT_EQ(Low128(wa.MulInt64(b)), a * b);
+    if (a >= 0) {
+      const int bits = 1 + static_cast<int>(rng() % 31);
+      Wide shifted = wa;
+      const std::uint32_t removed = shifted.ShiftRightInPlace(bits);
+      ASSERT_EQ(Low128(shifted), a >> bits);
+      ASSERT_EQ(removed, static_cast<std::uint32_t>(a & ((I128{1} << bits) - 1)));
+    }
   }
 }
 

@@ -123,9 +123,8 @@ TEST_F(Cli, SampleDoublePrintsTheReference) {
 }
 
 TEST_F(Cli, SampleReadsJson) {
-  const std::string file = Write(
-      "net.json",
-      R"({"units": "mm", "surfaces": [{"basis": "catmull-rom", "net": [
+  const std::string file = Write("net.json",
+                                 R"({"units": "mm", "surfaces": [{"basis": "catmull-rom", "net": [
         [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,0,0]],
         [[0,1,0],[1,1,1],[2,1,2],[3,1,1],[4,1,0]],
         [[0,2,0],[1,2,1],[2,2,3],[3,2,1],[4,2,0]],

@@ -61,8 +61,8 @@ Status Prepare(const RawPatch& raw, Basis basis, int n, int m, PreparedPatch<3>*
       for (int j = 0; j < 4; ++j) geometry[c].g[i][j] = GeometryFixed::FromRaw(raw.g[c][i][j]);
     }
   }
-  return PreparePatch(geometry, basis, static_cast<std::uint16_t>(n),
-                      static_cast<std::uint16_t>(m), options, out);
+  return PreparePatch(geometry, basis, static_cast<std::uint16_t>(n), static_cast<std::uint16_t>(m),
+                      options, out);
 }
 
 struct GridPoints {
@@ -79,12 +79,12 @@ template <typename Acc>
 void Step(const PreparedPatch<3>& prepared, GridPoints* s_lines, GridPoints* t_lines) {
   std::size_t count = 0;
   PatchStepper<Acc, 3>(prepared).ForEachSLinePoint(
-      [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&p)[3]) {
+      [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) {
         s_lines->Put(i, j, p);
         ++count;
       });
   PatchStepper<Acc, 3>(prepared).ForEachTLinePoint(
-      [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&p)[3]) {
+      [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) {
         t_lines->Put(i, j, p);
         ++count;
       });
@@ -117,8 +117,8 @@ int CheckPatch(const RawPatch& raw, Basis basis, int n, int m, PrepareOptions op
         const Rational exact = ExactPoint(basis, raw.g[c], i, n, j, m);
         if (!WithinBound(k, exact)) {
           if (++violations <= 3 && options.test_only_frac_bits_removed == 0) {
-            ADD_FAILURE() << BasisName(basis) << " " << n << "x" << m << " point (" << i << ","
-                          << j << ") coordinate " << c << ": got " << k << ", exact "
+            ADD_FAILURE() << BasisName(basis) << " " << n << "x" << m << " point (" << i << "," << j
+                          << ") coordinate " << c << ": got " << k << ", exact "
                           << testing::ToDouble(exact);
           }
         }
@@ -133,7 +133,7 @@ int CheckPatch(const RawPatch& raw, Basis basis, int n, int m, PrepareOptions op
 
 TEST(PatchEngine, RandomPatchesOfEveryBasisOnManyGrids) {
   std::mt19937_64 rng(20261122);
-  const int grids[][2] = {{1, 1},  {1, 7},   {2, 3},   {3, 3},   {5, 8},  {7, 13},
+  const int grids[][2] = {{1, 1},   {1, 7},    {2, 3},   {3, 3},   {5, 8},   {7, 13},
                           {16, 16}, {10, 100}, {33, 64}, {100, 1}, {63, 65}, {127, 3}};
   for (Basis basis : kAllBases) {
     for (const auto& grid : grids) {
@@ -296,7 +296,7 @@ TEST(CurveEngine, SeedHermiteExampleFirstSegment) {
     ASSERT_EQ(PrepareCurve(geometry, Basis::kHermite, static_cast<std::uint16_t>(n), {}, &curve),
               Status::kOk);
     int count = 0;
-    CurveStepper<Int128, 2>(curve).ForEachPoint([&](std::uint32_t i, const std::int32_t (&p)[2]) {
+    CurveStepper<Int128, 2>(curve).ForEachPoint([&](std::uint32_t i, const std::int32_t(&p)[2]) {
       // x·1000 at u = i/n, exactly: (1000n³ + 6000·i²·n − 4000·i³) / n³.
       const I128 n3 = I128(n) * n * n;
       const Rational exact_x{1000 * n3 + 6000 * I128(i) * i * n - 4000 * I128(i) * i * i, n3};
@@ -328,7 +328,7 @@ TEST(CurveEngine, RandomCurvesOfEveryBasisUpToTheLargestStepCount) {
       ASSERT_EQ(PrepareCurve(geometry, basis, static_cast<std::uint16_t>(n), {}, &curve),
                 Status::kOk);
       int bad = 0;
-      const auto check = [&](std::uint32_t i, const std::int32_t (&p)[3]) {
+      const auto check = [&](std::uint32_t i, const std::int32_t(&p)[3]) {
         for (int c = 0; c < 3; ++c) {
           Rational exact = ExactCurvePoint(static_cast<int>(basis), raw[c], i, n);
           exact.denominator *= kOneQuantumRaw;

@@ -43,8 +43,8 @@ TEST(Reference, WithinOneBillionthOfTheExactValue) {
       const int m = 1 + static_cast<int>(rng() % 300);
       for (int i = 0; i <= n; i += 1 + n / 17) {
         for (int j = 0; j <= m; j += 1 + m / 13) {
-          const Point3 p = EvaluateReference(patch, static_cast<double>(i) / n,
-                                             static_cast<double>(j) / m);
+          const Point3 p =
+              EvaluateReference(patch, static_cast<double>(i) / n, static_cast<double>(j) / m);
           for (int c = 0; c < 3; ++c) {
             const double exact = testing::ToDouble(
                 testing::ExactPatchPoint(static_cast<int>(basis), g[c], i, n, j, m));
@@ -119,7 +119,7 @@ Patch RandomDoublePatch(std::mt19937_64& rng, Basis basis) {
 Point3 FixedAt(const PreparedPatch<3>& prepared, const Quantum& q, std::uint32_t i,
                std::uint32_t j) {
   Point3 result{};
-  ForEachGridPoint(prepared, [&](std::uint32_t a, std::uint32_t b, const std::int32_t (&k)[3]) {
+  ForEachGridPoint(prepared, [&](std::uint32_t a, std::uint32_t b, const std::int32_t(&k)[3]) {
     if (a == i && b == j) {
       for (int c = 0; c < 3; ++c) result[c] = k[c] * q.value();
     }
@@ -188,7 +188,7 @@ TEST(Bases, BezierAndBSplineReproducePlanes) {
     const int n = 9;
     const int m = 10;
     const PreparedPatch<3> prepared = PrepareFixedPatch(patch, q, n, m);
-    ForEachGridPoint(prepared, [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&k)[3]) {
+    ForEachGridPoint(prepared, [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&k)[3]) {
       const double s = static_cast<double>(i) / n;
       const double t = static_cast<double>(j) / m;
       const double a = basis == Basis::kBezier ? 3 * s : 1 + s;

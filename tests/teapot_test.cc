@@ -16,9 +16,9 @@ double WorstError(const PatchSet& set, const Quantum& q, int n, int m) {
   for (const Patch& patch : set.patches) {
     const PreparedPatch<3> prepared = PrepareFixedPatch(patch, q, n, m);
     EXPECT_LE(ErrorBoundBeforeRounding(prepared, patch.basis), 0.01);
-    ForEachGridPoint(prepared, [&](std::uint32_t i, std::uint32_t j, const std::int32_t (&k)[3]) {
-      const Point3 exact = EvaluateReference(patch, static_cast<double>(i) / n,
-                                             static_cast<double>(j) / m);
+    ForEachGridPoint(prepared, [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&k)[3]) {
+      const Point3 exact =
+          EvaluateReference(patch, static_cast<double>(i) / n, static_cast<double>(j) / m);
       for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(k[c] - q.ToQuanta(exact[c])));
     });
   }

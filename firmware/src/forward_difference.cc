@@ -11,17 +11,20 @@
 namespace fdsurf {
 namespace {
 
+// Set-up products stay below 2^124 (docs/precision.md, "Set-up arithmetic")
+// and fit Narrow; scaling by 2^F before the rounding division needs Wide.
+using Narrow = internal::WideInt<4>;
 using Wide = internal::WideInt<8>;
 
 // One parametric direction of the table. A curve has one active direction;
 // its second direction is inactive: size 1, identity everywhere.
 struct Axis {
-  uint32_t steps;  // n
-  int size;        // 4 when active, 1 when inactive
+  uint32_t steps;   // n
+  int size;         // 4 when active, 1 when inactive
   int denominator;  // d, or 1 when inactive
-  // A = n³·E(1/n)·(d·M): maps geometry to scaled differences.
-  int64_t a[4][4];
-  // The integer basis d·M (used for the power coefficients C).
+  // E' = n³·E(1/n) = [[0,0,0,n³],[1,n,n²,0],[6,2n,0,0],[6,0,0,0]].
+  int64_t e[4][4];
+  // The integer basis d·M.
   int64_t basis[4][4];
   // weight[a][k] = ff(p,k)·(n+k)^(p-k)·n^(3-p), p = 3-a: n³·δ^k times the
   // largest |d^k/du^k u^p| on [0, 1+kδ] (see "Range" in docs/precision.md).
@@ -47,22 +50,18 @@ void MakeActiveAxis(uint32_t n, const BasisMatrix& m, Axis* axis) {
   const int64_t n1 = n;
   const int64_t n2 = n1 * n1;
   const int64_t n3 = n2 * n1;
-  // n³·E(1/n) with E(δ) = [[0,0,0,1],[δ³,δ²,δ,0],[6δ³,2δ²,0,0],[6δ³,0,0,0]].
   const int64_t e[4][4] = {{0, 0, 0, n3}, {1, n1, n2, 0}, {6, 2 * n1, 0, 0}, {6, 0, 0, 0}};
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) {
+      axis->e[r][c] = e[r][c];
       axis->basis[r][c] = m.matrix[r][c];
-      int64_t sum = 0;
-      for (int i = 0; i < 4; ++i) sum += e[r][i] * m.matrix[i][c];
-      axis->a[r][c] = sum;
     }
   }
   for (int a = 0; a < 4; ++a) {
     const int p = 3 - a;
     for (int k = 0; k < 4; ++k) {
-      axis->weight[a][k] = k > p ? 0
-                                 : FallingFactorial(p, k) * Power(n + k, p - k) *
-                                       Power(n, 3 - p);
+      axis->weight[a][k] =
+          k > p ? 0 : FallingFactorial(p, k) * Power(n + k, p - k) * Power(n, 3 - p);
     }
   }
 }
@@ -71,7 +70,7 @@ void MakeInactiveAxis(Axis* axis) {
   axis->steps = 0;
   axis->size = 1;
   axis->denominator = 1;
-  axis->a[0][0] = 1;
+  axis->e[0][0] = 1;
   axis->basis[0][0] = 1;
   axis->weight[0][0] = 1;
 }
@@ -91,67 +90,97 @@ int BitLength(uint64_t v) {
   return bits;
 }
 
-// D = d_s·d_t·n_s³·n_t³·2^g: exact difference = table entry / D.
-Wide Denominator(const Axis& s, const Axis& t) {
-  Wide d = Wide::FromInt64(1);
-  const Axis* axes[2] = {&s, &t};
-  for (const Axis* axis : axes) {
-    if (axis->size == 4) {
-      const Wide n = Wide::FromInt64(axis->steps);
-      d = d * n * n * n * Wide::FromInt64(axis->denominator);
-    }
+// The exact differences are the scaled table divided by
+// D = 2^g·d_s·d_t·n_s³·n_t³. Dividing by D is a shift by g and a few
+// single-limb divisions by the factors below, each under 2^32.
+struct Denominator {
+  uint32_t divisor[4];  // d_s·d_t, then n³ per patch axis (n and n² for a curve)
+  int count;
+  Wide value;
+  Wide half;  // D/2; D is even because it carries 2^g
+};
+
+Denominator MakeDenominator(const Axis& s, const Axis& t) {
+  Denominator d;
+  d.count = 0;
+  const uint32_t basis = static_cast<uint32_t>(s.denominator * t.denominator);
+  if (basis > 1) d.divisor[d.count++] = basis;
+  if (t.size == 4) {
+    // Patch axes have n ≤ kMaxPatchSteps = 1024, so n³ < 2^32.
+    d.divisor[d.count++] = s.steps * s.steps * s.steps;
+    d.divisor[d.count++] = t.steps * t.steps * t.steps;
+  } else {
+    // A curve's n may be up to 65535: n² < 2^32.
+    d.divisor[d.count++] = s.steps;
+    d.divisor[d.count++] = s.steps * s.steps;
   }
-  return d.ShiftedLeft(kGeometryFracBits);
+  d.value = Wide::PowerOfTwo(kGeometryFracBits);
+  for (int i = 0; i < d.count; ++i) d.value = d.value.MulInt64(d.divisor[i]);
+  d.half = Wide::PowerOfTwo(kGeometryFracBits - 1);
+  for (int i = 0; i < d.count; ++i) d.half = d.half.MulInt64(d.divisor[i]);
+  return d;
 }
 
-// The scaled table n_s³n_t³·d_s·d_t·2^g·DD = A_s·G·A_tᵀ for one coordinate,
-// and the scaled power coefficients d_s·d_t·2^g·C = (d_sM)·G·(d_tM)ᵀ.
-void ScaledTables(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Wide (&dd)[4][4],
-                  Wide (&c)[4][4]) {
-  Wide g_at[4][4];  // G·A_tᵀ
-  Wide g_mt[4][4];  // G·(d_tM)ᵀ
+// The scaled power coefficients d_s·d_t·2^g·C = (d_sM)·G·(d_tM)ᵀ. With
+// |G| < 2^47 and basis rows of absolute sum ≤ 12 they stay below 2^55.
+void PowerCoefficients(const int64_t (&g)[4][4], const Axis& s, const Axis& t, int64_t (&c)[4][4]) {
+  int64_t g_mt[4][4];  // G·(d_tM)ᵀ
   for (int i = 0; i < s.size; ++i) {
     for (int l = 0; l < t.size; ++l) {
-      Wide sum_a;
-      Wide sum_m;
-      for (int j = 0; j < t.size; ++j) {
-        const Wide gij = Wide::FromInt64(g[i][j]);
-        sum_a += gij * Wide::FromInt64(t.a[l][j]);
-        sum_m += gij * Wide::FromInt64(t.basis[l][j]);
-      }
-      g_at[i][l] = sum_a;
-      g_mt[i][l] = sum_m;
+      int64_t sum = 0;
+      for (int j = 0; j < t.size; ++j) sum += g[i][j] * t.basis[l][j];
+      g_mt[i][l] = sum;
     }
   }
   for (int k = 0; k < s.size; ++k) {
     for (int l = 0; l < t.size; ++l) {
-      Wide sum_a;
-      Wide sum_m;
-      for (int i = 0; i < s.size; ++i) {
-        sum_a += Wide::FromInt64(s.a[k][i]) * g_at[i][l];
-        sum_m += Wide::FromInt64(s.basis[k][i]) * g_mt[i][l];
-      }
-      dd[k][l] = sum_a;
-      c[k][l] = sum_m;
+      int64_t sum = 0;
+      for (int i = 0; i < s.size; ++i) sum += s.basis[k][i] * g_mt[i][l];
+      c[k][l] = sum;
     }
   }
 }
 
-// round(x·2^F / D) with halves away from zero, by successive exact floor
-// divisions of |x|·2^F + D/2 (D is even: it carries 2^g).
-Wide RoundedQuotient(const Wide& x, int frac_bits, const Axis& s, const Axis& t) {
-  const Wide denominator = Denominator(s, t);
-  Wide y = x.Abs().ShiftedLeft(frac_bits);
-  Wide half = denominator;
-  half.DivideInPlace(2);
-  y += half;
-  y.DivideInPlace(uint32_t{1} << kGeometryFracBits);
-  const Axis* axes[2] = {&s, &t};
-  for (const Axis* axis : axes) {
-    if (axis->size != 4) continue;
-    y.DivideInPlace(static_cast<uint32_t>(axis->denominator));
-    for (int i = 0; i < 3; ++i) y.DivideInPlace(axis->steps);
+// The scaled table D·DD = E'_s·(d_sd_t2^g·C)·E'_tᵀ. E' is sparse; skipping its
+// zeros is worth it here, as this runs for every patch.
+void ScaledTable(const int64_t (&c)[4][4], const Axis& s, const Axis& t, Narrow (&dd)[4][4]) {
+  Narrow c_et[4][4];  // C·E'_tᵀ
+  for (int i = 0; i < s.size; ++i) {
+    for (int l = 0; l < t.size; ++l) {
+      Narrow sum;
+      for (int j = 0; j < t.size; ++j) {
+        if (t.e[l][j] != 0) sum += Narrow::FromInt64(c[i][j]).MulInt64(t.e[l][j]);
+      }
+      c_et[i][l] = sum;
+    }
   }
+  for (int k = 0; k < s.size; ++k) {
+    for (int l = 0; l < t.size; ++l) {
+      Narrow sum;
+      for (int i = 0; i < s.size; ++i) {
+        if (s.e[k][i] != 0) sum += c_et[i][l].MulInt64(s.e[k][i]);
+      }
+      dd[k][l] = sum;
+    }
+  }
+}
+
+// round(x·2^F / D), halves away from zero: floor((|x|·2^F + D/2) / D) by
+// successive exact floor divisions, which compose for non-negative numbers.
+// Sets *exact when D divides x·2^F.
+Wide RoundedQuotient(const Narrow& x, int frac_bits, const Denominator& d, bool* exact) {
+  Wide y = x.Abs().Resized<Wide::kBits / 32>().ShiftedLeft(frac_bits) + d.half;
+  // Dividing by 2^g, e1, e2, ... in turn leaves remainders r0, r1, r2, ...
+  // and y = q·D + r with r = r0 + 2^g·(r1 + e1·(r2 + ...)).
+  const uint32_t low_bits = y.ShiftRightInPlace(kGeometryFracBits);
+  uint32_t remainders[4];
+  for (int i = 0; i < d.count; ++i) remainders[i] = y.DivideInPlace(d.divisor[i]);
+  Wide remainder;
+  for (int i = d.count - 1; i >= 0; --i) {
+    remainder = remainder.MulInt64(d.divisor[i]) + Wide::FromUint64(remainders[i]);
+  }
+  remainder = remainder.ShiftedLeft(kGeometryFracBits) + Wide::FromUint64(low_bits);
+  *exact = remainder == d.half;
   return x.IsNegative() ? -y : y;
 }
 
@@ -162,10 +191,9 @@ Int128 ToInt128(const Wide& w) {
   return v;
 }
 
-// The table of one coordinate, checked and rounded. `widths_ok` is narrowed
-// to the accumulator widths whose range holds every difference of it.
+// The table of one coordinate and the bounds on its differences.
 struct Plane {
-  Wide dd[4][4];     // scaled exact table
+  Narrow dd[4][4];   // scaled exact table
   Wide bound[4][4];  // scaled bound of |Δs^k Δt^l x| over the stepped box
 };
 
@@ -177,18 +205,28 @@ Status BuildPlane(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Plane*
       }
     }
   }
-  Wide c[4][4];
-  ScaledTables(g, s, t, plane->dd, c);
+  int64_t c[4][4];
+  PowerCoefficients(g, s, t, c);
+  ScaledTable(c, s, t, plane->dd);
+  // bound[k][l] = Σ_a Σ_b |c_ab|·w_s[a][k]·w_t[b][l], summed over b first.
+  Narrow partial[4][4];  // [a][l]
+  for (int a = 0; a < s.size; ++a) {
+    for (int l = 0; l < t.size; ++l) {
+      Narrow sum;
+      for (int b = 0; b < t.size; ++b) {
+        const int64_t magnitude = c[a][b] < 0 ? -c[a][b] : c[a][b];
+        sum += Narrow::FromInt64(magnitude).MulInt64(static_cast<int64_t>(t.weight[b][l]));
+      }
+      partial[a][l] = sum;
+    }
+  }
   for (int k = 0; k < s.size; ++k) {
     for (int l = 0; l < t.size; ++l) {
-      Wide sum;
+      Narrow sum;
       for (int a = 0; a < s.size; ++a) {
-        for (int b = 0; b < t.size; ++b) {
-          sum += c[a][b].Abs() * Wide::FromUint64(s.weight[a][k]) *
-                 Wide::FromUint64(t.weight[b][l]);
-        }
+        sum += partial[a][l].MulInt64(static_cast<int64_t>(s.weight[a][k]));
       }
-      plane->bound[k][l] = sum;
+      plane->bound[k][l] = sum.Resized<Wide::kBits / 32>();
     }
   }
   return Status::kOk;
@@ -196,23 +234,22 @@ Status BuildPlane(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Plane*
 
 // Every difference, plus one quantum for the accumulated rounding, must stay
 // below 2^(W-1) in units of 2^-F quanta: bound/D + 1 < 2^(W-1-F).
-bool FitsWidth(const Plane& plane, const Axis& s, const Axis& t, int acc_bits, int frac_bits) {
+bool FitsWidth(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d, int acc_bits,
+               int frac_bits) {
   const int headroom = acc_bits - 1 - frac_bits;
   if (headroom < 1) return false;
-  const Wide denominator = Denominator(s, t);
-  const Wide limit = denominator.ShiftedLeft(headroom);
+  const Wide limit = d.value.ShiftedLeft(headroom);
   for (int k = 0; k < s.size; ++k) {
     for (int l = 0; l < t.size; ++l) {
-      if (!(plane.bound[k][l] + denominator < limit)) return false;
+      if (!(plane.bound[k][l] + d.value < limit)) return false;
     }
   }
   return true;
 }
 
 // Positions themselves (plus a quantum) must fit the int32_t output.
-bool FitsOutput(const Plane& plane, const Axis& s, const Axis& t) {
-  const Wide denominator = Denominator(s, t);
-  return plane.bound[0][0] + denominator < denominator.ShiftedLeft(31);
+bool FitsOutput(const Plane& plane, const Denominator& d) {
+  return plane.bound[0][0] + d.value < d.value.ShiftedLeft(31);
 }
 
 template <int kDims>
@@ -221,11 +258,12 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
                Int128 (&table)[kDims][4][4]) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
   if (GetBasisMatrix(basis) == nullptr) return Status::kInvalidArgument;
+  const Denominator denominator = MakeDenominator(s, t);
   Plane planes[kDims];
   for (int c = 0; c < kDims; ++c) {
     const Status status = BuildPlane(g[c], s, t, &planes[c]);
     if (status != Status::kOk) return status;
-    if (!FitsOutput(planes[c], s, t)) return Status::kGeometryOutOfRange;
+    if (!FitsOutput(planes[c], denominator)) return Status::kGeometryOutOfRange;
   }
   int frac_bits = RequiredFracBits(s.steps, t.size == 4 ? t.steps : 0);
   frac_bits -= options.test_only_frac_bits_removed;
@@ -236,7 +274,9 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   for (int width : widths) {
     if (width > options.max_acc_bits) break;
     bool fits = true;
-    for (int c = 0; c < kDims && fits; ++c) fits = FitsWidth(planes[c], s, t, width, frac_bits);
+    for (int c = 0; c < kDims && fits; ++c) {
+      fits = FitsWidth(planes[c], s, t, denominator, width, frac_bits);
+    }
     if (fits) {
       acc_bits = width;
       break;
@@ -244,7 +284,6 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   }
   if (acc_bits == 0) return Status::kPrecisionUnreachable;
 
-  const Wide denominator = Denominator(s, t);
   bool all_exact = true;
   for (int c = 0; c < kDims; ++c) {
     for (int k = 0; k < 4; ++k) {
@@ -253,9 +292,10 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
           table[c][k][l] = Int128{0, 0};
           continue;
         }
-        const Wide q = RoundedQuotient(planes[c].dd[k][l], frac_bits, s, t);
-        if (q * denominator != planes[c].dd[k][l].ShiftedLeft(frac_bits)) all_exact = false;
-        table[c][k][l] = ToInt128(q);
+        bool entry_exact = false;
+        table[c][k][l] =
+            ToInt128(RoundedQuotient(planes[c].dd[k][l], frac_bits, denominator, &entry_exact));
+        all_exact = all_exact && entry_exact;
       }
     }
   }
@@ -324,12 +364,12 @@ Status PreparePatch(const PatchGeometry1 (&geometry)[kDims], Basis basis, uint16
   return Status::kOk;
 }
 
-template Status PrepareCurve<1>(const CurveGeometry1 (&)[1], Basis, uint16_t,
-                                const PrepareOptions&, PreparedCurve<1>*);
-template Status PrepareCurve<2>(const CurveGeometry1 (&)[2], Basis, uint16_t,
-                                const PrepareOptions&, PreparedCurve<2>*);
-template Status PrepareCurve<3>(const CurveGeometry1 (&)[3], Basis, uint16_t,
-                                const PrepareOptions&, PreparedCurve<3>*);
+template Status PrepareCurve<1>(const CurveGeometry1 (&)[1], Basis, uint16_t, const PrepareOptions&,
+                                PreparedCurve<1>*);
+template Status PrepareCurve<2>(const CurveGeometry1 (&)[2], Basis, uint16_t, const PrepareOptions&,
+                                PreparedCurve<2>*);
+template Status PrepareCurve<3>(const CurveGeometry1 (&)[3], Basis, uint16_t, const PrepareOptions&,
+                                PreparedCurve<3>*);
 template Status PreparePatch<1>(const PatchGeometry1 (&)[1], Basis, uint16_t, uint16_t,
                                 const PrepareOptions&, PreparedPatch<1>*);
 template Status PreparePatch<2>(const PatchGeometry1 (&)[2], Basis, uint16_t, uint16_t,

@@ -19,7 +19,9 @@ namespace {
 struct CountingSink {
   uint32_t count;
   template <int kDims>
-  void operator()(uint32_t, uint32_t, const int32_t (&)[kDims]) { ++count; }
+  void operator()(uint32_t, uint32_t, const int32_t (&)[kDims]) {
+    ++count;
+  }
 };
 }  // namespace
 

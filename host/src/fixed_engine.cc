@@ -61,8 +61,8 @@ PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, i
         const double q = quantum.ToQuanta(v);
         if (!std::isfinite(v) || !(std::fabs(q) < limit)) {
           std::ostringstream why;
-          why << patch.origin << ": geometry [" << i << "][" << j << "]." << kAxisNames[c]
-              << " = " << v << " is " << (std::isfinite(v) ? "out of range" : "not finite")
+          why << patch.origin << ": geometry [" << i << "][" << j << "]." << kAxisNames[c] << " = "
+              << v << " is " << (std::isfinite(v) ? "out of range" : "not finite")
               << ": at quantum " << quantum.Format(1)
               << " values must stay below 2^31 quanta in magnitude";
           throw EngineError(why.str());
@@ -76,9 +76,8 @@ PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, i
     throw EngineError(Explain(Status::kGridOutOfRange, patch, steps_s, steps_t, options));
   }
   PreparedPatch<3> prepared;
-  const Status status =
-      PreparePatch(geometry, patch.basis, static_cast<std::uint16_t>(steps_s),
-                   static_cast<std::uint16_t>(steps_t), options, &prepared);
+  const Status status = PreparePatch(geometry, patch.basis, static_cast<std::uint16_t>(steps_s),
+                                     static_cast<std::uint16_t>(steps_t), options, &prepared);
   if (status != Status::kOk) {
     throw EngineError(Explain(status, patch, steps_s, steps_t, options));
   }
@@ -89,10 +88,9 @@ double ErrorBoundBeforeRounding(const PreparedPatch<3>& patch, Basis basis) {
   const auto propagation = [](double n) {
     return 1 + n + n * (n - 1) / 2 + n * (n - 1) * (n - 2) / 6;
   };
-  const double stepping =
-      patch.exact ? 0.0
-                  : propagation(patch.steps_s) * propagation(patch.steps_t) *
-                        std::ldexp(1.0, -(patch.format.frac_bits + 1));
+  const double stepping = patch.exact ? 0.0
+                                      : propagation(patch.steps_s) * propagation(patch.steps_t) *
+                                            std::ldexp(1.0, -(patch.format.frac_bits + 1));
   const double conversion = LebesgueConstant(basis) * (std::ldexp(1.0, -17) + std::ldexp(1.0, -20));
   return stepping + conversion;
 }

@@ -4,9 +4,9 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <cstring>
 #include <sstream>
 
 namespace fdsurf::host {
@@ -106,7 +106,8 @@ Net ParseNet(const nlohmann::json& value, const JsonPlace& place) {
   for (std::size_t r = 0; r < value.size(); ++r) {
     const JsonPlace row_place = place.Index(r);
     const nlohmann::json& row = value[r];
-    if (!row.is_array() || row.empty()) throw row_place.Error("must be a non-empty array of points");
+    if (!row.is_array() || row.empty())
+      throw row_place.Error("must be a non-empty array of points");
     if (r > 0 && row.size() != net[0].size()) {
       throw row_place.Error("has " + std::to_string(row.size()) + " points but row 0 has " +
                             std::to_string(net[0].size()));
@@ -209,7 +210,8 @@ std::string LineAndColumn(const std::string& text, std::size_t offset) {
 }
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace

@@ -43,9 +43,7 @@ Quantum Quantum::Parse(const std::string& text, const std::string& what) {
   return q;
 }
 
-double Quantum::value() const {
-  return static_cast<double>(mantissa_) / std::pow(10.0, decimals_);
-}
+double Quantum::value() const { return static_cast<double>(mantissa_) / std::pow(10.0, decimals_); }
 
 double Quantum::ToQuanta(double value) const {
   // 10^decimals (≤ 10^9) and the mantissa (< 10^9) are exact in a double.

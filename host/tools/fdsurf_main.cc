@@ -94,11 +94,12 @@ int RunSample(const SampleOptions& options) {
   for (std::size_t p = 0; p < set.patches.size(); ++p) {
     const std::string prefix = std::to_string(p) + ",";
     if (fixed) {
-      ForEachGridPoint(prepared[p], [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&q)[3]) {
-        out.Append(prefix + std::to_string(i) + "," + std::to_string(j) + "," +
-                   quantum.Format(q[0]) + "," + quantum.Format(q[1]) + "," + quantum.Format(q[2]) +
-                   "\n");
-      });
+      ForEachGridPoint(prepared[p],
+                       [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&q)[3]) {
+                         out.Append(prefix + std::to_string(i) + "," + std::to_string(j) + "," +
+                                    quantum.Format(q[0]) + "," + quantum.Format(q[1]) + "," +
+                                    quantum.Format(q[2]) + "\n");
+                       });
     } else {
       for (int i = 0; i <= grid.steps_s; ++i) {
         for (int j = 0; j <= grid.steps_t; ++j) {
@@ -163,11 +164,13 @@ int RunCheck(const SampleOptions& options) {
 void AddCommonOptions(CLI::App* command, SampleOptions* options) {
   command->add_option("FILE", options->file, "patch file (.bpt or .json, see docs/formats.md)")
       ->required();
-  command->add_option("--grid", options->grid,
-                      "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))
+  command
+      ->add_option("--grid", options->grid,
+                   "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))
       ->required();
-  command->add_option("--quantum", options->quantum,
-                      "output quantum Q in file units; positions are whole multiples of Q")
+  command
+      ->add_option("--quantum", options->quantum,
+                   "output quantum Q in file units; positions are whole multiples of Q")
       ->capture_default_str();
 }
 
@@ -183,7 +186,8 @@ int main(int argc, char** argv) {
 
   SampleOptions sample_options;
   CLI::App* sample = app.add_subcommand(
-      "sample", "Print every grid point of every patch as CSV: patch,i,j,x,y,z (s = i/N, t = j/M).");
+      "sample",
+      "Print every grid point of every patch as CSV: patch,i,j,x,y,z (s = i/N, t = j/M).");
   AddCommonOptions(sample, &sample_options);
   sample
       ->add_option("--engine", sample_options.engine,

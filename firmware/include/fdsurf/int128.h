@@ -31,8 +31,7 @@ namespace internal {
 
 /// Two's complement reinterpretation, well defined for every value.
 inline int32_t ToInt32(uint32_t bits) {
-  return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits)
-                             : -static_cast<int32_t>(~bits) - 1;
+  return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits) : -static_cast<int32_t>(~bits) - 1;
 }
 
 }  // namespace internal

@@ -94,8 +94,8 @@ class WideInt {
     for (int i = 0; i < kLimbs; ++i) {
       uint64_t carry = 0;
       for (int j = 0; i + j < kLimbs; ++j) {
-        const uint64_t t = static_cast<uint64_t>(x.limb_[i]) * y.limb_[j] +
-                           product.limb_[i + j] + carry;
+        const uint64_t t =
+            static_cast<uint64_t>(x.limb_[i]) * y.limb_[j] + product.limb_[i + j] + carry;
         product.limb_[i + j] = static_cast<uint32_t>(t);
         carry = t >> 32;
       }
@@ -131,21 +131,68 @@ class WideInt {
     return 0;
   }
 
-  /// Divides a non-negative value by 1 <= divisor <= 65536 in place, rounding
-  /// towards zero, and returns the remainder. Works in 16-bit halves so that
-  /// only a 32-bit by 32-bit division is needed on every target.
-  uint32_t DivideInPlace(uint32_t divisor) {
-    uint32_t remainder = 0;
-    for (int i = kLimbs - 1; i >= 0; --i) {
-      const uint32_t high = (remainder << 16) | (limb_[i] >> 16);
-      const uint32_t q_high = high / divisor;
-      remainder = high % divisor;
-      const uint32_t low = (remainder << 16) | (limb_[i] & 0xFFFFu);
-      const uint32_t q_low = low / divisor;
-      remainder = low % divisor;
-      limb_[i] = (q_high << 16) | q_low;
+  /// The product with a 64-bit integer: cheaper than a full WideInt product,
+  /// and what most of the set-up's matrix products need. Truncating.
+  WideInt MulInt64(int64_t factor) const {
+    // In two's complement the low kBits of x·y are those of x·(y mod 2^64),
+    // less x·2^64 when y is negative.
+    const uint64_t y = static_cast<uint64_t>(factor);
+    const uint32_t y_limb[2] = {static_cast<uint32_t>(y), static_cast<uint32_t>(y >> 32)};
+    WideInt product;
+    for (int j = 0; j < 2; ++j) {
+      if (y_limb[j] == 0) continue;
+      uint64_t carry = 0;
+      for (int i = 0; i + j < kLimbs; ++i) {
+        const uint64_t t =
+            static_cast<uint64_t>(limb_[i]) * y_limb[j] + product.limb_[i + j] + carry;
+        product.limb_[i + j] = static_cast<uint32_t>(t);
+        carry = t >> 32;
+      }
     }
+    if (factor < 0) product -= ShiftedLeft(64);
+    return product;
+  }
+
+  /// The same value in another width (sign-extended or truncated).
+  template <int kOtherLimbs>
+  WideInt<kOtherLimbs> Resized() const {
+    WideInt<kOtherLimbs> result;
+    const uint32_t fill = IsNegative() ? 0xFFFFFFFFu : 0u;
+    for (int i = 0; i < kOtherLimbs; ++i) result.set_limb(i, i < kLimbs ? limb_[i] : fill);
+    return result;
+  }
+
+  void set_limb(int i, uint32_t value) { limb_[i] = value; }
+
+  /// Divides a non-negative value by 2^bits (1 <= bits <= 31) in place,
+  /// rounding towards zero, and returns the remainder (the bits shifted out).
+  uint32_t ShiftRightInPlace(int bits) {
+    const uint32_t remainder = limb_[0] & ((uint32_t{1} << bits) - 1);
+    for (int i = 0; i < kLimbs - 1; ++i) {
+      limb_[i] = (limb_[i] >> bits) | (limb_[i + 1] << (32 - bits));
+    }
+    limb_[kLimbs - 1] >>= bits;
     return remainder;
+  }
+
+  /// Divides a non-negative value by a divisor >= 1 in place, rounding
+  /// towards zero, and returns the remainder. Set-up only: on targets without
+  /// a hardware divide this calls the compiler's 64-bit division routine.
+  uint32_t DivideInPlace(uint32_t divisor) {
+    uint64_t remainder = 0;
+    for (int i = kLimbs - 1; i >= 0; --i) {
+      if (remainder == 0 && limb_[i] < divisor) {
+        // Leading limbs below the divisor give a zero quotient limb; most of
+        // the set-up's numbers leave the top limbs empty.
+        remainder = limb_[i];
+        limb_[i] = 0;
+        continue;
+      }
+      const uint64_t current = (remainder << 32) | limb_[i];
+      limb_[i] = static_cast<uint32_t>(current / divisor);
+      remainder = current % divisor;
+    }
+    return static_cast<uint32_t>(remainder);
   }
 
   friend bool operator==(const WideInt& a, const WideInt& b) {
