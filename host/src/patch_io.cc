@@ -157,14 +157,14 @@ void AddPatches(const Net& net, Basis basis, std::size_t stride, const JsonPlace
 }
 
 void AddSurface(const nlohmann::json& surface, const JsonPlace& place, PatchSet* set) {
-  if (!surface.is_object()) throw place.Error("must be an object with \"basis\" and \"net\"");
+  if (!surface.is_object()) throw place.Error(R"(must be an object with "basis" and "net")");
   for (const auto& [key, unused] : surface.items()) {
     if (key != "basis" && key != "net") {
-      throw place.Error("unknown field \"" + key + "\" (expected \"basis\" and \"net\")");
+      throw place.Error(R"(unknown field ")" + key + R"(" (expected "basis" and "net"))");
     }
   }
-  if (!surface.contains("basis")) throw place.Error("missing \"basis\"");
-  if (!surface.contains("net")) throw place.Error("missing \"net\"");
+  if (!surface.contains("basis")) throw place.Error(R"(missing "basis")");
+  if (!surface.contains("net")) throw place.Error(R"(missing "net")");
   const Basis basis = ParseBasis(surface["basis"], place.Child("basis"));
   const JsonPlace net_place = place.Child("net");
   const Net net = ParseNet(surface["net"], net_place);
@@ -279,18 +279,18 @@ PatchSet ParseJson(const std::string& text, const std::string& name) {
   if (!doc.is_object()) throw root.Error("the top level must be an object");
   for (const auto& [key, unused] : doc.items()) {
     if (key != "units" && key != "surfaces") {
-      throw root.Error("unknown field \"" + key + "\" (expected \"units\" and \"surfaces\")");
+      throw root.Error(R"(unknown field ")" + key + R"(" (expected "units" and "surfaces"))");
     }
   }
   PatchSet set;
   if (doc.contains("units")) {
     const nlohmann::json& units = doc["units"];
     if (!units.is_string() || (units != "mm" && units != "in")) {
-      throw root.Child("units").Error("must be \"mm\" or \"in\"");
+      throw root.Child("units").Error(R"(must be "mm" or "in")");
     }
     set.units = units.get<std::string>();
   }
-  if (!doc.contains("surfaces")) throw root.Error("missing \"surfaces\"");
+  if (!doc.contains("surfaces")) throw root.Error(R"(missing "surfaces")");
   const nlohmann::json& surfaces = doc["surfaces"];
   const JsonPlace surfaces_place{name, "surfaces"};
   if (!surfaces.is_array() || surfaces.empty()) {

@@ -174,11 +174,7 @@ void AddCommonOptions(CLI::App* command, SampleOptions* options) {
       ->capture_default_str();
 }
 
-}  // namespace
-}  // namespace fdsurf::host
-
-int main(int argc, char** argv) {
-  using namespace fdsurf::host;
+int Main(int argc, char** argv) {
   CLI::App app{
       "fdsurf: bicubic patches evaluated by fixed-point forward differences, with a proven "
       "0.51-quantum error bound."};
@@ -223,4 +219,18 @@ int main(int argc, char** argv) {
     return 3;
   }
   return 1;
+}
+
+}  // namespace
+}  // namespace fdsurf::host
+
+int main(int argc, char** argv) {
+  try {
+    return fdsurf::host::Main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fdsurf: internal error: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "fdsurf: internal error\n");
+  }
+  return 4;
 }

@@ -22,7 +22,7 @@ class WideInt {
   static_assert(kLimbs >= 2, "WideInt needs at least 64 bits");
   static constexpr int kBits = 32 * kLimbs;
 
-  constexpr WideInt() : limb_{} {}
+  constexpr WideInt() = default;
 
   static WideInt FromInt64(int64_t value) {
     WideInt w;
@@ -213,7 +213,7 @@ class WideInt {
   }
 
  private:
-  uint32_t limb_[kLimbs];
+  uint32_t limb_[kLimbs] = {};
 };
 
 }  // namespace internal
