@@ -175,6 +175,26 @@ TEST(PatchEngine, ExtremeControlPointsAtPlusMinusTwoToTheTwenty) {
   }
 }
 
+TEST(PrecisionPlanner, ServesEveryBasisAtPlusMinusTwoToTheTwentyOnEveryGrid) {
+  // The documented promise: geometry within ±2^20 quanta is always served.
+  std::mt19937_64 rng(37);
+  for (Basis basis : kAllBases) {
+    for (int trial = 0; trial < 50; ++trial) {
+      RawPatch patch;
+      for (auto& plane : patch.g) {
+        for (auto& row : plane) {
+          for (auto& v : row)
+            v = ((rng() & 1) != 0 ? 1 : -1) * (std::int64_t{1} << 20) * kOneQuantumRaw;
+        }
+      }
+      for (int n : {1, 2, 1000, 1024}) {
+        PreparedPatch<3> prepared;
+        EXPECT_EQ(Prepare(patch, basis, n, 1024, &prepared), Status::kOk) << BasisName(basis);
+      }
+    }
+  }
+}
+
 TEST(PatchEngine, PowerOfTwoGridsWithWholeQuantaAreExact) {
   // Integer-matrix bases, whole-quantum geometry, power-of-two steps: the
   // table is exact, so every point is the correctly rounded exact value.

@@ -293,8 +293,11 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
           continue;
         }
         bool entry_exact = false;
-        table[c][k][l] =
-            ToInt128(RoundedQuotient(planes[c].dd[k][l], frac_bits, denominator, &entry_exact));
+        const Wide q = RoundedQuotient(planes[c].dd[k][l], frac_bits, denominator, &entry_exact);
+        // Implied by FitsWidth; kept so that a planner bug refuses instead of
+        // wrapping around.
+        if (q.MagnitudeBits() > acc_bits - 1) return Status::kPrecisionUnreachable;
+        table[c][k][l] = ToInt128(q);
         all_exact = all_exact && entry_exact;
       }
     }

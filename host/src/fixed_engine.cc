@@ -34,7 +34,8 @@ std::string Explain(Status status, const Patch& patch, int steps_s, int steps_t,
       why << "each grid dimension must be between 1 and " << kMaxPatchSteps;
       break;
     case Status::kGeometryOutOfRange:
-      why << "the surface reaches beyond ±2^31 quanta; use a larger --quantum";
+      why << "the sum of its power coefficients, which bounds the surface, reaches ±2^31 "
+             "quanta (the output range); use a larger --quantum";
       break;
     case Status::kPrecisionUnreachable:
       why << "its differences need more than " << int{options.max_acc_bits}
