@@ -1,5 +1,6 @@
 // Instantiates every stepper template under the core's freestanding flags, so
 // that header-only code is held to the same rules as the .cc files.
+#include "fdsurf/adaptive.h"
 #include "fdsurf/forward_difference.h"
 
 namespace fdsurf {
@@ -14,6 +15,10 @@ template class PatchStepper<int64_t, 2>;
 template class PatchStepper<int64_t, 3>;
 template class PatchStepper<Int128, 2>;
 template class PatchStepper<Int128, 3>;
+template class AdaptiveCurveStepper<int64_t, 2>;
+template class AdaptiveCurveStepper<int64_t, 3>;
+template class AdaptiveCurveStepper<Int128, 2>;
+template class AdaptiveCurveStepper<Int128, 3>;
 
 namespace {
 struct CountingSink {
@@ -31,6 +36,14 @@ uint32_t FreestandingCheckCountPoints(const PreparedPatch<3>& patch) {
   PatchStepper<Int128, 3>(patch).ForEachSLinePoint(sink);
   PatchStepper<int64_t, 3>(patch).ForEachTLinePoint(sink);
   return sink.count;
+}
+
+uint32_t FreestandingCheckCountAdaptivePoints(const PreparedAdaptiveCurve<2>& curve) {
+  uint32_t count = 0;
+  const auto counter = [&count](uint32_t, const int32_t(&)[2]) { ++count; };
+  AdaptiveCurveStepper<Int128, 2>(curve).ForEachPoint(counter);
+  AdaptiveCurveStepper<int64_t, 2>(curve).ForEachPoint(counter);
+  return count;
 }
 
 }  // namespace fdsurf

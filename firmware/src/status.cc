@@ -14,6 +14,8 @@ const char* StatusMessage(Status status) {
       return "geometry out of range";
     case Status::kPrecisionUnreachable:
       return "precision unreachable";
+    case Status::kToleranceUnreachable:
+      return "tolerance below what whole-quantum output can meet";
   }
   return "unknown status";
 }

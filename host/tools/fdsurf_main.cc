@@ -1,7 +1,12 @@
 // fdsurf: the command-line tool. Every command validates its whole input
 // before it writes anything, so an error leaves stdout empty.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <charconv>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -11,6 +16,8 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quantum.h"
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/toolpath.h"
+#include "fdsurf/host/writers.h"
 
 namespace fdsurf::host {
 namespace {
@@ -161,6 +168,263 @@ int RunCheck(const SampleOptions& options) {
   return worst <= 0.51 ? 0 : 1;
 }
 
+
+std::string Number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+struct PlotOptions {
+  std::string file;
+  std::string format;
+  std::string output = "-";
+  std::string png;
+  int png_width = 1600;
+  std::string tolerance;
+  std::string lines = "8";
+  std::string view = "iso";
+  std::string units = "mm";
+  std::string fit;
+  std::string margin;
+  std::string quantum;
+  std::string mode = "adaptive";
+  int dims = 2;
+  bool plan = true;
+  bool quiet = false;
+  GcodeOptions gcode;
+};
+
+double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false) {
+  double value = 0;
+  std::size_t used = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw InputError(what + ": '" + text + "' is not a number");
+  }
+  if (value < 0 || (value == 0 && !allow_zero)) {
+    throw InputError(what + ": '" + text + "' must be " + (allow_zero ? "zero or more" : "greater than zero"));
+  }
+  return value;
+}
+
+std::array<int, 2> ParseLines(const std::string& text) {
+  const std::size_t x = text.find('x');
+  const auto parse = [&](std::string_view part) {
+    int value = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size() || value == 1 ||
+        value < 0 || value > kMaxPatchSteps + 1) {
+      throw InputError("--lines: '" + text + "' is not U or UxV with each count 0 (left out) or 2.." +
+                       std::to_string(kMaxPatchSteps + 1));
+    }
+    return value;
+  };
+  const std::string_view all(text);
+  const int u = parse(all.substr(0, x));
+  return {u, x == std::string::npos ? u : parse(all.substr(x + 1))};
+}
+
+std::array<double, 2> ParsePage(const std::string& text) {
+  const std::size_t x = text.find('x');
+  if (x == std::string::npos) throw InputError("--fit: '" + text + "' is not WxH (like 200x150)");
+  return {ParsePositive(text.substr(0, x), "--fit width"), ParsePositive(text.substr(x + 1), "--fit height")};
+}
+
+std::string FormatFromName(const std::string& name) {
+  const auto ends_with = [&](const char* ext) {
+    const std::string e(ext);
+    return name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0;
+  };
+  if (ends_with(".gcode") || ends_with(".nc") || ends_with(".ngc")) return "gcode";
+  if (ends_with(".hpgl") || ends_with(".plt")) return "hpgl";
+  if (ends_with(".json")) return "json";
+  return "svg";
+}
+
+// Every output is written to a temporary file beside its destination first;
+// only when all of them are complete are they renamed into place.
+class StagedOutputs {
+ public:
+  StagedOutputs() = default;
+  StagedOutputs(const StagedOutputs&) = delete;
+  StagedOutputs& operator=(const StagedOutputs&) = delete;
+  ~StagedOutputs() {
+    for (const auto& [temporary, final_name] : staged_) std::remove(temporary.c_str());
+  }
+  std::string Stage(const std::string& file) {
+    std::string temporary = file + ".fdsurf-" + std::to_string(getpid()) + ".tmp";
+    staged_.emplace_back(temporary, file);
+    return temporary;
+  }
+  void Commit() {
+    for (const auto& [temporary, final_name] : staged_) {
+      if (std::rename(temporary.c_str(), final_name.c_str()) != 0) {
+        throw OutputError(final_name + ": cannot write: " + std::strerror(errno));
+      }
+    }
+    staged_.clear();
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;
+};
+
+bool ShowProgress(bool quiet) { return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr; }
+
+int RunPlot(const PlotOptions& o, bool render_only) {
+  const std::string format = render_only ? "png" : (o.format.empty() ? FormatFromName(o.output) : o.format);
+  const bool hpgl = format == "hpgl";
+  // Option values are in --units; HPGL files are always in plotter units of
+  // 0.025 mm, so an HPGL job works in mm internally.
+  const double to_work = hpgl && o.units == "in" ? 25.4 : 1.0;
+  const std::string work_units = hpgl ? "mm" : o.units;
+  ToolpathOptions t;
+  t.tolerance = to_work * (o.tolerance.empty() ? (o.units == "in" ? 0.002 : 0.05)
+                                                : ParsePositive(o.tolerance, "--tolerance"));
+  const auto lines = ParseLines(o.lines);
+  t.lines_s = lines[0];
+  t.lines_t = lines[1];
+  t.view = ParseView(o.view);
+  if (!o.fit.empty()) {
+    auto page = ParsePage(o.fit);
+    t.fit = std::array<double, 2>{page[0] * to_work, page[1] * to_work};
+  }
+  t.margin = to_work * (o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0) : ParsePositive(o.margin, "--margin", true));
+  if (hpgl) {
+    if (!o.quantum.empty() && o.quantum != "0.025") {
+      throw InputError("--quantum: HPGL positions are plotter units of 0.025 mm; leave --quantum out");
+    }
+    t.quantum = Quantum::Parse("0.025");
+  } else {
+    t.quantum = Quantum::Parse(o.quantum.empty() ? (o.units == "in" ? "0.0001" : "0.001") : o.quantum);
+  }
+  if (o.dims == 3 && format != "gcode" && format != "json") {
+    throw InputError("--dims 3: only G-code and JSON carry a third axis");
+  }
+  t.dims = o.dims;
+  t.mode = o.mode == "fixed" ? StepMode::kFixed : o.mode == "step-exact" ? StepMode::kStepExact : StepMode::kAdaptive;
+
+  const PatchSet set = ReadPatchFile(o.file);
+  const std::string file_units = set.units.empty() ? "mm" : set.units;
+  t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
+
+  const bool progress = ShowProgress(o.quiet);
+  Toolpath path = BuildToolpath(set, t, work_units, [&](std::size_t done, std::size_t all, std::size_t points) {
+    if (progress) {
+      std::fprintf(stderr, "\rfdsurf: patch %zu/%zu (%3zu%%), %zu points", done, all, done * 100 / all, points);
+    }
+  });
+  if (progress) std::fputc('\n', stderr);
+  std::size_t points = 0;
+  for (const Stroke& s : path.strokes) points += s.points.size();
+  const std::size_t curves = path.strokes.size();
+  PlanReport plan;
+  if (o.plan) plan = PlanStrokes(&path);
+
+  std::vector<std::string> header = {
+      "generated by fdsurf plot (fixed-point forward differences)",
+      "source: " + o.file + " (" + std::to_string(set.patches.size()) + " patches)",
+      "view " + t.view.name + ", lines " + std::to_string(t.lines_s) + "x" + std::to_string(t.lines_t) +
+          ", mode " + o.mode + ", tolerance " + Number(t.tolerance) + " " + work_units + ", quantum " +
+          t.quantum.Format(1) + " " + work_units,
+      "page " + Number(path.width) + " x " + Number(path.height) + " " + work_units + ", " +
+          std::to_string(path.strokes.size()) + " strokes, " + std::to_string(points) + " points"};
+
+  StagedOutputs outputs;
+  std::string content;
+  if (format == "svg") content = WriteSvg(path, o.file + " drawn by fdsurf");
+  if (format == "gcode") content = WriteGcode(path, o.gcode, header);
+  if (format == "hpgl") content = WriteHpgl(path);
+  if (format == "json") content = WriteStrokesJson(path);
+  const std::string png = render_only ? o.output : o.png;
+  if (!png.empty()) RenderPng(path, o.png_width, outputs.Stage(png));
+  if (!render_only) {
+    if (o.output == "-") {
+      outputs.Commit();
+      std::fwrite(content.data(), 1, content.size(), stdout);
+    } else {
+      WriteFile(outputs.Stage(o.output), content);
+      outputs.Commit();
+    }
+  } else {
+    outputs.Commit();
+  }
+  if (!o.quiet) {
+    std::fprintf(stderr, "%s: %zu patches, %zu curves, %zu points (%s, tolerance %s %s)\n", o.file.c_str(),
+                 set.patches.size(), curves, points, o.mode.c_str(), Number(t.tolerance).c_str(),
+                 work_units.c_str());
+    if (o.plan) {
+      std::fprintf(stderr,
+                   "plan: %zu strokes -> %zu (%zu drawn twice removed); pen-down %.1f -> %.1f %s; "
+                   "pen-up %.1f -> %.1f %s\n",
+                   plan.strokes_before, plan.strokes_after, plan.duplicates_removed, plan.pen_down_before,
+                   plan.pen_down_after, work_units.c_str(), plan.pen_up_before, plan.pen_up_after,
+                   work_units.c_str());
+    }
+    if (!render_only && o.output != "-") {
+      std::fprintf(stderr, "wrote %s (%s, page %s x %s %s)\n", o.output.c_str(), format.c_str(),
+                   Number(path.width).c_str(), Number(path.height).c_str(), work_units.c_str());
+    }
+    if (!png.empty()) std::fprintf(stderr, "wrote %s (png, %d px wide)\n", png.c_str(), o.png_width);
+  }
+  return 0;
+}
+
+void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
+  command->add_option("FILE", o->file, "patch file (.bpt or .json, see docs/formats.md)")->required();
+  if (render_only) {
+    command->add_option("-o,--output", o->output, "the PNG file to write")->required();
+  } else {
+    command->add_option("--format", o->format, "svg, gcode, hpgl or json (default: from -o's extension, else svg)")
+        ->check(CLI::IsMember({"svg", "gcode", "hpgl", "json"}));
+    command->add_option("-o,--output", o->output, "output file, - for stdout")->capture_default_str();
+    command->add_option("--png", o->png, "also draw the result as a PNG picture");
+  }
+  command->add_option("--size", o->png_width, "PNG width in pixels")->check(CLI::Range(16, 20000))->capture_default_str();
+  command->add_option("--tolerance", o->tolerance,
+                      "largest distance of the drawing from the exact curves, in --units (default 0.05 mm / "
+                      "0.002 in)");
+  command->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
+      ->capture_default_str();
+  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")->capture_default_str();
+  command->add_option("--units", o->units, "units of the output and of these options")
+      ->check(CLI::IsMember({"mm", "in"}))
+      ->capture_default_str();
+  command->add_option("--fit", o->fit, "scale the drawing to fit a WxH page");
+  command->add_option("--margin", o->margin, "space around the drawing (default 5 mm / 0.2 in)");
+  command->add_option("--quantum", o->quantum, "output resolution (default 0.001 mm / 0.0001 in; HPGL 0.025 mm)");
+  command->add_option("--mode", o->mode, "adaptive, fixed (uniform steps) or step-exact (≤ 1 quantum per axis)")
+      ->check(CLI::IsMember({"adaptive", "fixed", "step-exact"}))
+      ->capture_default_str();
+  if (!render_only) {
+    command->add_option("--dims", o->dims, "2 (the view plane) or 3 (with depth, for CNC G-code)")
+        ->check(CLI::IsMember({2, 3}))
+        ->capture_default_str();
+    command->add_option("--pen", o->gcode.pen, "G-code pen control: z (Z moves) or m3 (M3/M5 and a dwell)")
+        ->check(CLI::IsMember({"z", "m3"}))
+        ->capture_default_str();
+    command->add_option("--pen-up", o->gcode.pen_up_z, "G-code Z with the pen up (also 3-D travel height)")
+        ->capture_default_str();
+    command->add_option("--pen-down", o->gcode.pen_down_z, "G-code Z with the pen down")->capture_default_str();
+    command->add_option("--feed", o->gcode.feed, "G-code drawing feed, units per minute")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    command->add_option("--plunge-feed", o->gcode.plunge_feed, "G-code pen-down feed")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    command->add_option("--dwell", o->gcode.dwell, "G-code dwell after M3/M5, seconds")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
+    command->add_flag("!--no-plan", o->plan, "keep the curves as drawn, without joining or ordering");
+  }
+  command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
+}
+
 void AddCommonOptions(CLI::App* command, SampleOptions* options) {
   command->add_option("FILE", options->file, "patch file (.bpt or .json, see docs/formats.md)")
       ->required();
@@ -196,10 +460,20 @@ int Main(int argc, char** argv) {
       "check", "Compare the fixed engine with the double reference on every grid point.");
   AddCommonOptions(check, &check_options);
 
+  PlotOptions plot_options;
+  CLI::App* plot = app.add_subcommand(
+      "plot", "Draw the patches as a wireframe of isolines for a plotter or CNC: SVG, G-code, HPGL.");
+  AddPlotOptions(plot, &plot_options, false);
+  PlotOptions render_options;
+  CLI::App* render = app.add_subcommand("render", "Draw the patches' isolines as a PNG picture.");
+  AddPlotOptions(render, &render_options, true);
+
   // CLI11 would only say "a subcommand is required" for a mistyped command.
-  if (argc > 1 && argv[1][0] != '-' && std::string(argv[1]) != "sample" &&
-      std::string(argv[1]) != "check") {
-    std::fprintf(stderr, "fdsurf: error: unknown command '%s' (expected sample or check)\n",
+  const std::string first = argc > 1 ? argv[1] : "";
+  if (argc > 1 && argv[1][0] != '-' && first != "sample" && first != "check" && first != "plot" &&
+      first != "render") {
+    std::fprintf(stderr,
+                 "fdsurf: error: unknown command '%s' (expected sample, check, plot or render)\n",
                  argv[1]);
     return 2;
   }
@@ -211,7 +485,12 @@ int Main(int argc, char** argv) {
   try {
     if (sample->parsed()) return RunSample(sample_options);
     if (check->parsed()) return RunCheck(check_options);
+    if (plot->parsed()) return RunPlot(plot_options, false);
+    if (render->parsed()) return RunPlot(render_options, true);
   } catch (const InputError& e) {
+    std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
+    return 2;
+  } catch (const OutputError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
     return 2;
   } catch (const EngineError& e) {

@@ -24,7 +24,30 @@ struct Int128 {
     return *this;
   }
 
+  Int128& operator-=(const Int128& other) {
+    const uint64_t lo_difference = lo - other.lo;
+    hi -= other.hi + (lo < other.lo ? 1u : 0u);
+    lo = lo_difference;
+    return *this;
+  }
+
+  Int128 operator-() const {
+    Int128 zero{0, 0};
+    zero -= *this;
+    return zero;
+  }
+
+  bool IsNegative() const { return (hi >> 63) != 0; }
+
+  friend Int128 operator+(Int128 a, const Int128& b) { return a += b; }
+  friend Int128 operator-(Int128 a, const Int128& b) { return a -= b; }
   friend bool operator==(const Int128& a, const Int128& b) { return a.lo == b.lo && a.hi == b.hi; }
+  friend bool operator<=(const Int128& a, const Int128& b) {
+    // Flipping the sign bit maps two's complement order onto unsigned order.
+    const uint64_t a_hi = a.hi ^ (uint64_t{1} << 63);
+    const uint64_t b_hi = b.hi ^ (uint64_t{1} << 63);
+    return a_hi < b_hi || (a_hi == b_hi && a.lo <= b.lo);
+  }
 };
 
 namespace internal {
@@ -32,6 +55,33 @@ namespace internal {
 /// Two's complement reinterpretation, well defined for every value.
 inline int32_t ToInt32(uint32_t bits) {
   return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits) : -static_cast<int32_t>(~bits) - 1;
+}
+
+/// The shifts and magnitude test of the adaptive stepper, for both
+/// accumulators. Shifts go through unsigned arithmetic so that negative values
+/// shift the same way on every compiler; 1 <= bits <= 63.
+inline int64_t ShiftLeft(int64_t value, int bits) {
+  return static_cast<int64_t>(static_cast<uint64_t>(value) << bits);
+}
+inline int64_t ShiftRightArithmetic(int64_t value, int bits) {
+  const uint64_t u = static_cast<uint64_t>(value);
+  return static_cast<int64_t>(value < 0 ? ~(~u >> bits) : u >> bits);
+}
+/// |value| <= limit, for limit >= 0.
+inline bool WithinMagnitude(int64_t value, int64_t limit) {
+  return value <= limit && value >= -limit;
+}
+
+inline Int128 ShiftLeft(const Int128& value, int bits) {
+  return Int128{value.lo << bits, (value.hi << bits) | (value.lo >> (64 - bits))};
+}
+inline Int128 ShiftRightArithmetic(const Int128& value, int bits) {
+  const uint64_t sign_fill = value.IsNegative() ? ~uint64_t{0} : 0;
+  return Int128{(value.lo >> bits) | (value.hi << (64 - bits)),
+                (value.hi >> bits) | (sign_fill << (64 - bits))};
+}
+inline bool WithinMagnitude(const Int128& value, const Int128& limit) {
+  return value <= limit && -limit <= value;
 }
 
 }  // namespace internal

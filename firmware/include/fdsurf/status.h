@@ -17,6 +17,9 @@ enum class Status : uint8_t {
   /// No accumulator width allowed by the caller can hold every difference of
   /// this patch with the fractional bits the error bound needs.
   kPrecisionUnreachable,
+  /// An adaptive curve's tolerance is not above what rounding to whole quanta
+  /// already uses (sqrt(dims)·(0.5 + 2^-10) quanta).
+  kToleranceUnreachable,
 };
 
 /// A short, stable, human-readable name for a status ("ok", "grid out of range", ...).

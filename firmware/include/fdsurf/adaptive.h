@@ -1,0 +1,257 @@
+// Adaptive forward differencing of cubic curves and of the isoparametric
+// curves of bicubic patches.
+//
+// A curve is prepared once at its finest step 2^-L, exactly: its power
+// coefficients are rounded once to 2^-16 quanta, and the difference vector is
+// held in units of 2^-(16+3L) quanta, where every difference at every step
+// 2^-l (l ≤ L) is an integer. Stepping then adapts the step by powers of two
+// with exact integer transforms of the difference vector:
+//
+//   double the step:  Δ¹ ← 2Δ¹ + Δ²,   Δ² ← 4Δ² + 4Δ³,   Δ³ ← 8Δ³
+//   halve the step:   Δ¹ ← (8Δ¹ − 2Δ² + Δ³)/16,  Δ² ← (2Δ² − Δ³)/8,  Δ³ ← Δ³/8
+//
+// (the divisions are exact, because the halved table is again a table of the
+// same exact curve at a step no finer than 2^-L), and each step is the
+// row-add update. No multiplies or divides in the loop: shifts, additions and
+// comparisons only.
+//
+// The chord test: on a step, the chord between two consecutive exact points
+// lies within max(|Δ²|, |Δ² − Δ³|)/8 of the curve, per axis. With every
+// emitted point rounded to whole quanta, the polyline of emitted points is
+// within sqrt(dims)·(max/8 + 0.5 + 2^-10) quanta of the exact curve in the
+// Euclidean norm; the stepper keeps that under the caller's tolerance.
+// docs/toolpaths.md proves both statements.
+#pragma once
+
+#include <stdint.h>
+
+#include "fdsurf/basis.h"
+#include "fdsurf/forward_difference.h"
+#include "fdsurf/int128.h"
+#include "fdsurf/status.h"
+
+namespace fdsurf {
+
+/// The finest step is at least 2^-kMaxAdaptiveLevel of the parameter range.
+constexpr int kMaxAdaptiveLevel = 30;
+/// Fractional bits of the power coefficients of an adaptive curve.
+constexpr int kCoefficientFracBits = 16;
+
+/// What the stepper keeps within bounds besides the point positions.
+enum class AdaptiveMode : uint8_t {
+  /// Every chord within the tolerance of the curve, with as few points as the
+  /// power-of-two step adaptation allows.
+  kTolerance = 0,
+  /// Additionally, consecutive points differ by at most one quantum per axis
+  /// (a step-exact path for machines that move one motor step at a time).
+  /// Repeated points are not emitted.
+  kStepExact = 1,
+};
+
+struct AdaptiveSettings {
+  AdaptiveMode mode = AdaptiveMode::kTolerance;
+  /// The Euclidean tolerance between the emitted polyline and the exact curve,
+  /// in units of 2^-8 quanta. Must exceed sqrt(dims)·(0.5 + 2^-10) quanta.
+  uint32_t tolerance_q8 = 0;
+  /// 64 refuses curves that need the 128-bit accumulator.
+  uint8_t max_acc_bits = 128;
+};
+
+/// One coordinate of a cubic a·t³ + b·t² + c·t + d as integers in units of
+/// 2^-kCoefficientFracBits quanta: c[0] = a, ..., c[3] = d.
+struct PowerCurve1 {
+  int64_t c[4];
+};
+
+/// A curve ready for adaptive stepping.
+template <int kDims>
+struct PreparedAdaptiveCurve {
+  /// frac_bits = kCoefficientFracBits + 3·finest_level.
+  DiffFormat format;
+  /// L: the finest step is 2^-L; positions are reported in these units.
+  uint8_t finest_level;
+  AdaptiveMode mode;
+  /// Δ⁰..Δ³ per axis at t = 0 for the step 2^-L.
+  Int128 d[kDims][4];
+  /// A step is taken only when max(|Δ²|, |Δ² − Δ³|) ≤ chord_limit on every axis.
+  Int128 chord_limit;
+  /// In kStepExact, a step is taken only when |Δ¹| ≤ step_limit (one quantum).
+  Int128 step_limit;
+};
+
+/// Plans and sets up one curve from its power coefficients. Errors:
+/// kToleranceUnreachable (tolerance too small for whole-quantum output),
+/// kGeometryOutOfRange (positions could reach ±2^31 quanta),
+/// kPrecisionUnreachable (no step ≥ 2^-kMaxAdaptiveLevel meets the tolerance
+/// or the step limit, or no allowed accumulator holds the differences).
+template <int kDims>
+Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
+                            PreparedAdaptiveCurve<kDims>* out);
+
+/// Converts a curve's basis geometry (fdsurf/forward_difference.h) to power
+/// coefficients, rounding each once to 2^-kCoefficientFracBits quanta.
+/// Errors: kInvalidArgument (basis), kGeometryOutOfRange (|g| ≥ 2^31 quanta).
+template <int kDims>
+Status CurvePowerCoefficients(const CurveGeometry1 (&geometry)[kDims], Basis basis,
+                              PowerCurve1 (&out)[kDims]);
+
+/// Which isoparametric curves of a patch.
+enum class IsolineFamily : uint8_t {
+  /// s fixed on each line, t from 0 to 1 along it.
+  kSLines = 0,
+  /// t fixed on each line, s from 0 to 1 along it.
+  kTLines = 1,
+};
+
+/// Produces the evenly spaced isolines of a patch one after the other, by
+/// forward differences across the patch: the table n³·E(1/n)·C (n = lines − 1,
+/// scaled to integers, exact) is stepped with the row-add update for s-lines,
+/// or its transpose for t-lines, and row 0 is the next line's coefficients.
+/// Only the per-line rounding of those coefficients divides.
+template <int kDims>
+class IsolineWalker {
+ public:
+  /// `lines` ≥ 2 lines at parameters i/(lines − 1), i = 0..lines − 1, with
+  /// lines − 1 ≤ kMaxPatchSteps. Errors: kInvalidArgument (basis),
+  /// kGridOutOfRange (lines), kGeometryOutOfRange (|g| ≥ 2^31 quanta).
+  static Status Create(const PatchGeometry1 (&geometry)[kDims], Basis basis, IsolineFamily family,
+                       uint16_t lines, IsolineWalker* out);
+
+  uint16_t lines() const { return lines_; }
+  /// How many lines Next() has produced.
+  uint16_t produced() const { return produced_; }
+
+  /// The power coefficients (in t for s-lines, in s for t-lines) of the next
+  /// line, then one row-add step across the patch. Returns false after the
+  /// last line.
+  bool Next(PowerCurve1 (&curve)[kDims]);
+
+ private:
+  /// Per coordinate: row k is the k-th difference across the patch; column l
+  /// multiplies the along-line power u^(3-l). Scaled by divisor_ and by
+  /// 2^kCoefficientFracBits.
+  Int128 table_[kDims][4][4];
+  uint32_t divisor_[2];  // d² (basis denominators), n³
+  uint16_t lines_;
+  uint16_t produced_;
+};
+
+namespace internal {
+
+/// Whether every axis passes the chord test (and, in step-exact mode, the
+/// one-quantum step test) for the current step.
+template <typename Acc, int kDims>
+inline bool StepFits(const Acc (&d)[kDims][4], const Acc& chord_limit, const Acc& step_limit,
+                     bool step_exact) {
+  for (int c = 0; c < kDims; ++c) {
+    if (!WithinMagnitude(d[c][2], chord_limit)) return false;
+    if (!WithinMagnitude(d[c][2] - d[c][3], chord_limit)) return false;
+    if (step_exact && !WithinMagnitude(d[c][1], step_limit)) return false;
+  }
+  return true;
+}
+
+/// The same test for the doubled step, without forming it: the doubled Δ² is
+/// 4(Δ² + Δ³) and the doubled Δ² − Δ³ is 4(Δ² − Δ³); the doubled Δ¹ is 2Δ¹ + Δ².
+template <typename Acc, int kDims>
+inline bool DoubledStepFits(const Acc (&d)[kDims][4], const Acc& quarter_chord_limit,
+                            const Acc& step_limit, bool step_exact) {
+  for (int c = 0; c < kDims; ++c) {
+    if (!WithinMagnitude(d[c][2] + d[c][3], quarter_chord_limit)) return false;
+    if (!WithinMagnitude(d[c][2] - d[c][3], quarter_chord_limit)) return false;
+    if (step_exact && !WithinMagnitude(ShiftLeft(d[c][1], 1) + d[c][2], step_limit)) return false;
+  }
+  return true;
+}
+
+template <typename Acc>
+inline void DoubleStep(Acc* d) {
+  d[1] = ShiftLeft(d[1], 1) + d[2];
+  d[2] = ShiftLeft(d[2] + d[3], 2);
+  d[3] = ShiftLeft(d[3], 3);
+}
+
+template <typename Acc>
+inline void HalveStep(Acc* d) {
+  const Acc d1 = ShiftRightArithmetic(ShiftLeft(d[1], 3) - ShiftLeft(d[2], 1) + d[3], 4);
+  const Acc d2 = ShiftRightArithmetic(ShiftLeft(d[2], 1) - d[3], 3);
+  d[1] = d1;
+  d[2] = d2;
+  d[3] = ShiftRightArithmetic(d[3], 3);
+}
+
+}  // namespace internal
+
+/// Steps a prepared adaptive curve with accumulator Acc (int64_t only when
+/// format.acc_bits == 64, else Int128). Sink is called as
+/// sink(position, point): position in units of 2^-finest_level of the
+/// parameter (0 first, 2^finest_level last), point a `const int32_t (&)[kDims]`
+/// in whole quanta.
+template <typename Acc, int kDims>
+class AdaptiveCurveStepper {
+ public:
+  explicit AdaptiveCurveStepper(const PreparedAdaptiveCurve<kDims>& curve)
+      : frac_bits_(curve.format.frac_bits),
+        finest_level_(curve.finest_level),
+        step_exact_(curve.mode == AdaptiveMode::kStepExact) {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+    }
+    internal::Load(curve.chord_limit, &chord_limit_);
+    internal::Load(curve.step_limit, &step_limit_);
+    quarter_chord_limit_ = internal::ShiftRightArithmetic(chord_limit_, 2);
+  }
+
+  template <typename Sink>
+  void ForEachPoint(Sink&& sink) const {
+    Acc d[kDims][4];
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) d[c][k] = d_[c][k];
+    }
+    int32_t point[kDims];
+    int32_t last[kDims];
+    for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(d[c][0], frac_bits_);
+    sink(uint32_t{0}, point);
+    for (int c = 0; c < kDims; ++c) last[c] = point[c];
+
+    const uint32_t end = uint32_t{1} << finest_level_;
+    uint32_t position = 0;
+    uint32_t step = 1;  // in units of the finest step
+    while (position < end) {
+      // Halve when the step fails or would overshoot t = 1. The planner
+      // proved the finest step always passes, so this stops at 1 at the latest.
+      while (step > 1 && (step > end - position ||
+                          !internal::StepFits(d, chord_limit_, step_limit_, step_exact_))) {
+        for (int c = 0; c < kDims; ++c) internal::HalveStep(d[c]);
+        step >>= 1;
+      }
+      while (step <= (end - position) / 2 &&
+             internal::DoubledStepFits(d, quarter_chord_limit_, step_limit_, step_exact_)) {
+        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d[c]);
+        step <<= 1;
+      }
+      for (int c = 0; c < kDims; ++c) internal::Step(d[c]);
+      position += step;
+      bool moved = !step_exact_;
+      for (int c = 0; c < kDims; ++c) {
+        point[c] = RoundToQuanta(d[c][0], frac_bits_);
+        moved = moved || point[c] != last[c];
+      }
+      if (moved) {
+        sink(position, point);
+        for (int c = 0; c < kDims; ++c) last[c] = point[c];
+      }
+    }
+  }
+
+ private:
+  Acc d_[kDims][4];
+  Acc chord_limit_;
+  Acc quarter_chord_limit_;
+  Acc step_limit_;
+  int frac_bits_;
+  int finest_level_;
+  bool step_exact_;
+};
+
+}  // namespace fdsurf

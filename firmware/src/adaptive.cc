@@ -1,0 +1,262 @@
+// Set-up of adaptive curves and of the isoline walker. docs/toolpaths.md
+// derives the level choice, the range bound and the chord test used here.
+#include "fdsurf/adaptive.h"
+
+#include "fdsurf/internal/wide_int.h"
+
+namespace fdsurf {
+namespace {
+
+using Wide = internal::WideInt<8>;
+
+// Coordinates of the √dims factor: 256/√dims rounded down, so that a limit
+// computed with it is never looser than the exact one.
+const int64_t kInverseSqrtDims256[4] = {0, 256, 181, 147};
+
+// Allowance, in 2^-16 quanta, for the errors made before stepping: the
+// rounding of the geometry to 2^-16 quanta (≤ 16·(2^-17 + 2^-20) for the power
+// basis, less for the others) and of the 4 power coefficients (≤ 4·2^-17).
+constexpr int64_t kPreStepAllowance16 = 64;  // 2^-10 quanta
+
+uint64_t Magnitude(int64_t v) {
+  return v < 0 ? ~static_cast<uint64_t>(v) + 1 : static_cast<uint64_t>(v);
+}
+
+Int128 ToInt128(const Wide& w) {
+  Int128 v;
+  v.lo = static_cast<uint64_t>(w.limb(0)) | (static_cast<uint64_t>(w.limb(1)) << 32);
+  v.hi = static_cast<uint64_t>(w.limb(2)) | (static_cast<uint64_t>(w.limb(3)) << 32);
+  return v;
+}
+
+internal::WideInt<4> FromInt128(const Int128& v) {
+  internal::WideInt<4> w;
+  w.set_limb(0, static_cast<uint32_t>(v.lo));
+  w.set_limb(1, static_cast<uint32_t>(v.lo >> 32));
+  w.set_limb(2, static_cast<uint32_t>(v.hi));
+  w.set_limb(3, static_cast<uint32_t>(v.hi >> 32));
+  return w;
+}
+
+bool GeometryInRange(int64_t v) { return v < kGeometryLimitRaw && v > -kGeometryLimitRaw; }
+
+// round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
+// floor((2|x| + ab) / 2ab) by successive floor divisions, which compose.
+int64_t RoundedQuotient(const internal::WideInt<4>& x, uint32_t a, uint32_t b) {
+  internal::WideInt<4> y = x.Abs().ShiftedLeft(1) +
+                           internal::WideInt<4>::FromUint64(static_cast<uint64_t>(a) * b);
+  y.ShiftRightInPlace(1);
+  y.DivideInPlace(a);
+  y.DivideInPlace(b);
+  const uint64_t magnitude = static_cast<uint64_t>(y.limb(0)) | (static_cast<uint64_t>(y.limb(1)) << 32);
+  const int64_t value = static_cast<int64_t>(magnitude);
+  return x.IsNegative() ? -value : value;
+}
+
+}  // namespace
+
+template <int kDims>
+Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
+                            PreparedAdaptiveCurve<kDims>* out) {
+  static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
+  const int64_t budget16 = static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
+                           (int64_t{1} << 15) - kPreStepAllowance16;
+  if (budget16 <= 0) return Status::kToleranceUnreachable;
+  const bool step_exact = settings.mode == AdaptiveMode::kStepExact;
+
+  // Per axis: |a|, |b|, |c|, |d|, in 2^-16 quanta.
+  uint64_t m[kDims][4];
+  for (int c = 0; c < kDims; ++c) {
+    uint64_t sum = 0;
+    for (int k = 0; k < 4; ++k) {
+      m[c][k] = Magnitude(curve[c].c[k]);
+      if (m[c][k] >= static_cast<uint64_t>(kGeometryLimitRaw)) return Status::kGeometryOutOfRange;
+      sum += m[c][k];
+    }
+    // |x(t)| ≤ Σ|coefficients|; with the rounding half it must stay in int32.
+    if (sum + (uint64_t{1} << 15) >= static_cast<uint64_t>(kGeometryLimitRaw)) {
+      return Status::kGeometryOutOfRange;
+    }
+  }
+
+  // The finest level L: the smallest at which every step of 2^-L passes.
+  // In units of 2^-(16+3L) quanta, |Δ²| ≤ (6|a| + 2|b|)·2^L + 6|a| and
+  // |Δ² − Δ³| is smaller; the chord limit is 8·budget = budget16·2^(3+3L).
+  // In step-exact mode also |Δ¹| ≤ (3|a| + 2|b| + |c|)·2^(2L) ≤ 2^(16+3L).
+  int level = 0;
+  for (;; ++level) {
+    if (level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
+    bool fits = true;
+    const Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
+    for (int c = 0; c < kDims && fits; ++c) {
+      const Wide second = Wide::FromUint64(6 * m[c][0] + 2 * m[c][1]).ShiftedLeft(level) +
+                          Wide::FromUint64(6 * m[c][0]);
+      fits = !(chord_limit < second);
+      if (fits && step_exact) {
+        const Wide first = Wide::FromUint64(3 * m[c][0] + 2 * m[c][1] + m[c][2]);
+        fits = !(Wide::PowerOfTwo(kCoefficientFracBits + level) < first);
+      }
+    }
+    if (fits) break;
+  }
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+
+  // Every value the stepper forms (differences at any level up to step 1,
+  // the doubling and halving intermediates, the rounding half) is below
+  // 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F.
+  Wide largest;
+  for (int c = 0; c < kDims; ++c) {
+    const Wide bound =
+        Wide::FromUint64(8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3])).ShiftedLeft(3 * level) +
+        Wide::PowerOfTwo(frac_bits);
+    if (largest < bound) largest = bound;
+  }
+  int acc_bits = 0;
+  if (frac_bits <= 62 && largest < Wide::PowerOfTwo(62) && settings.max_acc_bits >= 64) {
+    acc_bits = 64;
+  } else if (largest < Wide::PowerOfTwo(126) && settings.max_acc_bits >= 128) {
+    acc_bits = 128;
+  } else {
+    return Status::kPrecisionUnreachable;
+  }
+
+  PreparedAdaptiveCurve<kDims> result;
+  result.format.acc_bits = static_cast<uint8_t>(acc_bits);
+  result.format.frac_bits = static_cast<uint8_t>(frac_bits);
+  result.finest_level = static_cast<uint8_t>(level);
+  result.mode = settings.mode;
+  for (int c = 0; c < kDims; ++c) {
+    const Wide a = Wide::FromInt64(curve[c].c[0]);
+    const Wide b = Wide::FromInt64(curve[c].c[1]);
+    const Wide cc = Wide::FromInt64(curve[c].c[2]);
+    const Wide d = Wide::FromInt64(curve[c].c[3]);
+    // Step h = 2^-L in units of 2^-(16+3L): Δ⁰ = d·2^3L, Δ¹ = a + b·2^L + c·2^2L,
+    // Δ² = 6a + 2b·2^L, Δ³ = 6a.
+    result.d[c][0] = ToInt128(d.ShiftedLeft(3 * level));
+    result.d[c][1] = ToInt128(a + b.ShiftedLeft(level) + cc.ShiftedLeft(2 * level));
+    result.d[c][2] = ToInt128(a.MulInt64(6) + b.ShiftedLeft(level + 1));
+    result.d[c][3] = ToInt128(a.MulInt64(6));
+  }
+  // Values never exceed `largest`, so a larger limit would act the same;
+  // clamping keeps it representable in the accumulator.
+  Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
+  const Wide clamp = Wide::PowerOfTwo(acc_bits - 2);
+  if (clamp < chord_limit) chord_limit = clamp;
+  result.chord_limit = ToInt128(chord_limit);
+  result.step_limit = ToInt128(Wide::PowerOfTwo(frac_bits));
+  *out = result;
+  return Status::kOk;
+}
+
+template <int kDims>
+Status CurvePowerCoefficients(const CurveGeometry1 (&geometry)[kDims], Basis basis,
+                              PowerCurve1 (&out)[kDims]) {
+  const BasisMatrix* m = GetBasisMatrix(basis);
+  if (m == nullptr) return Status::kInvalidArgument;
+  PowerCurve1 result[kDims];
+  for (int c = 0; c < kDims; ++c) {
+    for (int i = 0; i < 4; ++i) {
+      if (!GeometryInRange(geometry[c].g[i].Raw())) return Status::kGeometryOutOfRange;
+    }
+    for (int k = 0; k < 4; ++k) {
+      int64_t scaled = 0;  // |scaled| < 12·2^47
+      for (int i = 0; i < 4; ++i) scaled += m->matrix[k][i] * geometry[c].g[i].Raw();
+      result[c].c[k] =
+          RoundedQuotient(internal::WideInt<4>::FromInt64(scaled), static_cast<uint32_t>(m->denominator), 1);
+    }
+  }
+  for (int c = 0; c < kDims; ++c) out[c] = result[c];
+  return Status::kOk;
+}
+
+template <int kDims>
+Status IsolineWalker<kDims>::Create(const PatchGeometry1 (&geometry)[kDims], Basis basis,
+                                    IsolineFamily family, uint16_t lines, IsolineWalker* out) {
+  const BasisMatrix* m = GetBasisMatrix(basis);
+  if (m == nullptr) return Status::kInvalidArgument;
+  if (lines < 2 || lines - 1 > kMaxPatchSteps) return Status::kGridOutOfRange;
+  const int64_t n = lines - 1;
+  // E' = n³·E(1/n), the integer form of the difference operator across the patch.
+  const int64_t e[4][4] = {{0, 0, 0, n * n * n}, {1, n, n * n, 0}, {6, 2 * n, 0, 0}, {6, 0, 0, 0}};
+  IsolineWalker walker;
+  for (int c = 0; c < kDims; ++c) {
+    const PatchGeometry1& g = geometry[c];
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        if (!GeometryInRange(g.g[i][j].Raw())) return Status::kGeometryOutOfRange;
+      }
+    }
+    // d²·2^16·C = (dM)·G·(dM)ᵀ, below 12·12·2^47 < 2^55 in magnitude.
+    int64_t g_mt[4][4];
+    for (int i = 0; i < 4; ++i) {
+      for (int l = 0; l < 4; ++l) {
+        int64_t sum = 0;
+        for (int j = 0; j < 4; ++j) sum += g.g[i][j].Raw() * m->matrix[l][j];
+        g_mt[i][l] = sum;
+      }
+    }
+    int64_t power[4][4];  // [across][along]
+    for (int k = 0; k < 4; ++k) {
+      for (int l = 0; l < 4; ++l) {
+        int64_t sum = 0;
+        for (int i = 0; i < 4; ++i) sum += m->matrix[k][i] * g_mt[i][l];
+        if (family == IsolineFamily::kSLines) {
+          power[k][l] = sum;
+        } else {
+          power[l][k] = sum;
+        }
+      }
+    }
+    // The table E'·power: entries below 4·2^30·2^55 = 2^87.
+    for (int r = 0; r < 4; ++r) {
+      for (int l = 0; l < 4; ++l) {
+        internal::WideInt<4> sum;
+        for (int k = 0; k < 4; ++k) {
+          if (e[r][k] != 0) sum += internal::WideInt<4>::FromInt64(power[k][l]).MulInt64(e[r][k]);
+        }
+        const Wide wide = sum.Resized<8>();
+        walker.table_[c][r][l] = ToInt128(wide);
+      }
+    }
+  }
+  walker.divisor_[0] = static_cast<uint32_t>(m->denominator * m->denominator);
+  walker.divisor_[1] = static_cast<uint32_t>(n * n * n);
+  walker.lines_ = lines;
+  walker.produced_ = 0;
+  *out = walker;
+  return Status::kOk;
+}
+
+template <int kDims>
+bool IsolineWalker<kDims>::Next(PowerCurve1 (&curve)[kDims]) {
+  if (produced_ >= lines_) return false;
+  for (int c = 0; c < kDims; ++c) {
+    for (int l = 0; l < 4; ++l) {
+      curve[c].c[l] = RoundedQuotient(FromInt128(table_[c][0][l]), divisor_[0], divisor_[1]);
+    }
+  }
+  ++produced_;
+  for (int c = 0; c < kDims; ++c) {
+    for (int l = 0; l < 4; ++l) {
+      table_[c][0][l] += table_[c][1][l];
+      table_[c][1][l] += table_[c][2][l];
+      table_[c][2][l] += table_[c][3][l];
+    }
+  }
+  return true;
+}
+
+template Status PrepareAdaptiveCurve<1>(const PowerCurve1 (&)[1], const AdaptiveSettings&,
+                                        PreparedAdaptiveCurve<1>*);
+template Status PrepareAdaptiveCurve<2>(const PowerCurve1 (&)[2], const AdaptiveSettings&,
+                                        PreparedAdaptiveCurve<2>*);
+template Status PrepareAdaptiveCurve<3>(const PowerCurve1 (&)[3], const AdaptiveSettings&,
+                                        PreparedAdaptiveCurve<3>*);
+template Status CurvePowerCoefficients<1>(const CurveGeometry1 (&)[1], Basis, PowerCurve1 (&)[1]);
+template Status CurvePowerCoefficients<2>(const CurveGeometry1 (&)[2], Basis, PowerCurve1 (&)[2]);
+template Status CurvePowerCoefficients<3>(const CurveGeometry1 (&)[3], Basis, PowerCurve1 (&)[3]);
+template class IsolineWalker<1>;
+template class IsolineWalker<2>;
+template class IsolineWalker<3>;
+
+}  // namespace fdsurf

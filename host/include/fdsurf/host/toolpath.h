@@ -1,0 +1,133 @@
+// Toolpaths: patch sets drawn as wireframes of isoparametric curves.
+//
+// Each patch is mapped affinely into output space (a view's projection, a
+// scale and an offset, applied to the geometry itself, which is exact for
+// every basis), and each isoline is produced by the core's forward-difference
+// engine: the IsolineWalker steps across the patch, the adaptive stepper walks
+// along the line. docs/toolpaths.md proves the tolerance that every stroke
+// keeps from the exact curve.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fdsurf/adaptive.h"
+#include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/quantum.h"
+
+namespace fdsurf::host {
+
+/// An orthographic view: output axes as rows of a rotation of model space.
+/// `right` and `up` span the drawing plane, `depth` = right × up points to
+/// the viewer (the Z of 3-D output).
+struct View {
+  std::string name;
+  std::array<double, 3> right{};
+  std::array<double, 3> up{};
+  std::array<double, 3> depth{};
+};
+
+/// "top", "front", "side", "iso" or "AZ,EL" in degrees (azimuth from +x
+/// towards +y of the eye's direction, elevation above the xy plane).
+/// Throws InputError naming `what`.
+View ParseView(const std::string& text, const std::string& what = "--view");
+
+/// How curves are stepped.
+enum class StepMode {
+  /// Adaptive forward differences: every chord within the tolerance.
+  kAdaptive,
+  /// Uniform steps: per curve, the fewest that the same chord bound allows.
+  kFixed,
+  /// Adaptive, and at most one quantum per axis per step (step-exact).
+  kStepExact,
+};
+
+struct ToolpathOptions {
+  /// Largest distance between the drawn polyline and the exact curve, in
+  /// output units (Euclidean, in the output's 2 or 3 dimensions).
+  double tolerance = 0.05;
+  /// Isolines per patch along each family (s-lines: s fixed; t-lines: t
+  /// fixed), each ≥ 2, or 0 to leave the family out.
+  int lines_s = 8;
+  int lines_t = 8;
+  View view;
+  /// Output units per file unit (25.4 for a file in inches drawn in mm).
+  double units_scale = 1.0;
+  /// When set, the drawing is scaled uniformly to fit this page (output units).
+  std::optional<std::array<double, 2>> fit;
+  /// Space kept around the drawing (output units).
+  double margin = 0.0;
+  /// Output resolution: every point is a whole multiple of it.
+  Quantum quantum;
+  /// 2: the view plane; 3: plus depth (for CNC).
+  int dims = 2;
+  StepMode mode = StepMode::kAdaptive;
+};
+
+/// The affine map from file coordinates to output units.
+struct OutputMap {
+  View view;
+  double scale = 1.0;
+  std::array<double, 3> offset{};
+  std::array<double, 3> Apply(const Point3& p) const;
+  std::array<double, 3> ApplyLinear(const Point3& v) const;
+};
+
+/// One drawn curve: whole-quantum points (z = 0 when dims = 2) and where
+/// they come from, so tests can compare them with the exact curve.
+struct Stroke {
+  std::vector<std::array<std::int64_t, 3>> points;
+  /// The parameter along the isoline of each point (before planning).
+  std::vector<double> params;
+  std::size_t patch = 0;
+  IsolineFamily family = IsolineFamily::kSLines;
+  /// Fixed parameter of the isoline (s for s-lines, t for t-lines).
+  double line_param = 0;
+};
+
+struct Toolpath {
+  int dims = 2;
+  std::string units;  // "mm" or "in"
+  Quantum quantum;
+  OutputMap map;
+  /// The page: [0, width] × [0, height] in output units.
+  double width = 0;
+  double height = 0;
+  std::vector<Stroke> strokes;
+};
+
+/// Called after each patch with (patches done, patches in all, points so far).
+using Progress = std::function<void(std::size_t, std::size_t, std::size_t)>;
+
+/// Draws every patch's isolines. Throws InputError for options that cannot
+/// be met (tolerance below the quantum's reach, a drawing that does not fit)
+/// and EngineError (fixed_engine.h) when the engine refuses a curve.
+Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, const std::string& units,
+                       const Progress& progress = {});
+
+/// The exact point of an isoline in output units (the double reference,
+/// through the same map), for checks.
+std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path, const Stroke& stroke,
+                                       double param);
+
+struct PlanReport {
+  std::size_t strokes_before = 0;
+  std::size_t strokes_after = 0;
+  std::size_t duplicates_removed = 0;
+  double pen_down_before = 0;
+  double pen_down_after = 0;
+  double pen_up_before = 0;
+  double pen_up_after = 0;
+};
+
+/// Plans the pen's path: removes strokes drawn twice (shared patch edges),
+/// joins strokes that meet end to end, orders them by nearest neighbour from
+/// the origin with a 2-opt improvement pass, reversing strokes where it
+/// helps. Distances are in output units, in the drawing plane.
+PlanReport PlanStrokes(Toolpath* path);
+
+}  // namespace fdsurf::host

@@ -1,0 +1,517 @@
+#include "fdsurf/host/toolpath.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "fdsurf/forward_difference.h"
+#include "fdsurf/host/fixed_engine.h"
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/reference.h"
+
+namespace fdsurf::host {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::array<double, 3> Cross(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double Dot(const std::array<double, 3>& a, const Point3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+View ViewFromAngles(const std::string& name, double azimuth_deg, double elevation_deg) {
+  const double az = azimuth_deg * kPi / 180;
+  const double el = elevation_deg * kPi / 180;
+  View v;
+  v.name = name;
+  v.depth = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+  v.right = {-std::sin(az), std::cos(az), 0};
+  v.up = Cross(v.depth, v.right);
+  return v;
+}
+
+// The range of a·u³ + b·u² + c·u + d over [0, 1]: the ends and the roots of
+// the derivative inside.
+std::array<double, 2> CubicRange(double a, double b, double c, double d) {
+  const auto f = [&](double u) { return ((a * u + b) * u + c) * u + d; };
+  double lo = std::min(f(0), f(1));
+  double hi = std::max(f(0), f(1));
+  const auto consider = [&](double u) {
+    if (u > 0 && u < 1) {
+      lo = std::min(lo, f(u));
+      hi = std::max(hi, f(u));
+    }
+  };
+  const double qa = 3 * a, qb = 2 * b, qc = c;
+  if (std::fabs(qa) < 1e-300) {
+    if (qb != 0) consider(-qc / qb);
+  } else {
+    const double disc = qb * qb - 4 * qa * qc;
+    if (disc >= 0) {
+      const double root = std::sqrt(disc);
+      consider((-qb + root) / (2 * qa));
+      consider((-qb - root) / (2 * qa));
+    }
+  }
+  return {lo, hi};
+}
+
+// The power coefficients (model space) of one isoline of a patch:
+// coefficient l multiplies u^(3-l) along the line.
+std::array<Point3, 4> LineCoefficients(const PowerCoefficients& pc, IsolineFamily family,
+                                       double at) {
+  const double powers[4] = {at * at * at, at * at, at, 1};
+  std::array<Point3, 4> line{};
+  for (int l = 0; l < 4; ++l) {
+    for (int k = 0; k < 4; ++k) {
+      const Point3& c = family == IsolineFamily::kSLines ? pc.c[k][l] : pc.c[l][k];
+      for (int axis = 0; axis < 3; ++axis) line[l][axis] += powers[k] * c[axis];
+    }
+  }
+  return line;
+}
+
+double LineParam(int i, int lines) { return lines == 1 ? 0.0 : static_cast<double>(i) / (lines - 1); }
+
+struct Box {
+  std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  std::array<double, 3> hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+};
+
+// The exact bounding box of the drawn isolines in view coordinates at scale 1.
+Box DrawingBox(const PatchSet& set, const ToolpathOptions& options) {
+  Box box;
+  for (const Patch& patch : set.patches) {
+    const PowerCoefficients pc = CoefficientsOf(patch);
+    const auto family_box = [&](IsolineFamily family, int lines) {
+      for (int i = 0; i < lines; ++i) {
+        const auto line = LineCoefficients(pc, family, LineParam(i, lines));
+        const std::array<double, 3>* axes[3] = {&options.view.right, &options.view.up,
+                                                &options.view.depth};
+        for (int a = 0; a < 3; ++a) {
+          const auto range = CubicRange(Dot(*axes[a], line[0]), Dot(*axes[a], line[1]),
+                                        Dot(*axes[a], line[2]), Dot(*axes[a], line[3]));
+          box.lo[a] = std::min(box.lo[a], range[0]);
+          box.hi[a] = std::max(box.hi[a], range[1]);
+        }
+      }
+    };
+    family_box(IsolineFamily::kSLines, options.lines_s);
+    family_box(IsolineFamily::kTLines, options.lines_t);
+  }
+  return box;
+}
+
+// Whether G[i][j] is a point (moves with the offset) or a vector (does not):
+// Hermite tangents and twists, and every power coefficient but the constant.
+bool IsPoint(Basis basis, int i, int j) {
+  switch (basis) {
+    case Basis::kHermite:
+      return i < 2 && j < 2;
+    case Basis::kPower:
+      return i == 3 && j == 3;
+    default:
+      return true;
+  }
+}
+
+std::string Number(double v) {
+  std::ostringstream out;
+  out.precision(6);
+  out << v;
+  return out.str();
+}
+
+constexpr double kInverseSqrt[4] = {0, 1.0, 0.70710678118654752, 0.57735026918962576};
+
+template <int kDims>
+void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
+               const ToolpathOptions& options, std::vector<Stroke>* strokes) {
+  const Quantum& quantum = options.quantum;
+  PatchGeometry1 geometry[kDims];
+  const double limit = std::ldexp(1.0, 31);
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const auto out = IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
+      for (int c = 0; c < kDims; ++c) {
+        const double q = quantum.ToQuanta(out[c]);
+        if (!(std::fabs(q) < limit)) {
+          throw EngineError(patch.origin + ": in output space a control value reaches " + Number(out[c]) +
+                            " " + "units, beyond ±2^31 quanta of " + quantum.Format(1) +
+                            "; use a coarser quantum or a smaller --fit");
+        }
+        geometry[c].g[i][j] = GeometryFixed::FromRaw(
+            static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
+      }
+    }
+  }
+  const double tolerance_q = options.tolerance / quantum.value();
+  AdaptiveSettings settings;
+  settings.mode = options.mode == StepMode::kStepExact ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
+  settings.tolerance_q8 = static_cast<std::uint32_t>(std::min(std::floor(tolerance_q * 256), 4294967295.0));
+
+  const auto refuse = [&](Status status, const std::string& line) {
+    std::string why = patch.origin + ": " + line + ": ";
+    switch (status) {
+      case Status::kPrecisionUnreachable:
+        why += options.mode == StepMode::kStepExact
+                   ? "a step-exact path would need steps below 2^-30 of the curve or more than 128 "
+                     "accumulator bits; use a coarser quantum"
+                   : "the tolerance needs steps below 2^-30 of the curve; use a larger --tolerance";
+        break;
+      case Status::kGeometryOutOfRange:
+        why += "the curve could reach ±2^31 quanta; use a coarser quantum";
+        break;
+      default:
+        why += StatusMessage(status);
+    }
+    throw EngineError(why);
+  };
+
+  const auto draw_family = [&](IsolineFamily family, int lines) {
+    if (lines == 0) return;
+    IsolineWalker<kDims> walker;
+    const Status created =
+        IsolineWalker<kDims>::Create(geometry, patch.basis, family, static_cast<std::uint16_t>(lines), &walker);
+    if (created != Status::kOk) refuse(created, "isolines");
+    PowerCurve1 curve[kDims];
+    for (int i = 0; walker.Next(curve); ++i) {
+      Stroke stroke;
+      stroke.patch = index;
+      stroke.family = family;
+      stroke.line_param = LineParam(i, lines);
+      const std::string name =
+          std::string(family == IsolineFamily::kSLines ? "s" : "t") + "-line " + std::to_string(i);
+      const auto add = [&](double param, const std::int32_t (&p)[kDims]) {
+        std::array<std::int64_t, 3> point{0, 0, 0};
+        for (int c = 0; c < kDims; ++c) point[c] = p[c];
+        stroke.points.push_back(point);
+        stroke.params.push_back(param);
+      };
+      if (options.mode == StepMode::kFixed) {
+        // The fewest uniform steps N with √d/8·max|x''|/N² + √d·0.511 ≤ tolerance (0.51 stepping, 2^-12 geometry and coefficient rounding).
+        double second = 0;
+        for (int c = 0; c < kDims; ++c) {
+          second = std::max(second, (6 * std::fabs(static_cast<double>(curve[c].c[0])) +
+                                     2 * std::fabs(static_cast<double>(curve[c].c[1]))) /
+                                        65536.0);
+        }
+        const double budget = tolerance_q * kInverseSqrt[kDims] - 0.511;
+        const double n = std::max(1.0, std::ceil(std::sqrt(second / (8 * budget)) * (1 + 1e-12)));
+        if (!(n <= kMaxCurveSteps)) refuse(Status::kPrecisionUnreachable, name);
+        CurveGeometry1 power[kDims];
+        for (int c = 0; c < kDims; ++c) {
+          for (int k = 0; k < 4; ++k) power[c].g[k] = GeometryFixed::FromRaw(curve[c].c[k]);
+        }
+        PreparedCurve<kDims> prepared;
+        const Status status =
+            PrepareCurve(power, Basis::kPower, static_cast<std::uint16_t>(n), PrepareOptions{}, &prepared);
+        if (status != Status::kOk) refuse(status, name);
+        const auto sink = [&](std::uint32_t k, const std::int32_t (&p)[kDims]) { add(k / n, p); };
+        if (prepared.format.acc_bits == 64) {
+          CurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
+        } else {
+          CurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
+        }
+      } else {
+        PreparedAdaptiveCurve<kDims> prepared;
+        const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
+        if (status != Status::kOk) refuse(status, name);
+        const double unit = std::ldexp(1.0, -prepared.finest_level);
+        const auto sink = [&](std::uint32_t position, const std::int32_t (&p)[kDims]) {
+          add(position * unit, p);
+        };
+        if (prepared.format.acc_bits == 64) {
+          AdaptiveCurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
+        } else {
+          AdaptiveCurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
+        }
+      }
+      strokes->push_back(std::move(stroke));
+    }
+  };
+  draw_family(IsolineFamily::kSLines, options.lines_s);
+  draw_family(IsolineFamily::kTLines, options.lines_t);
+}
+
+double PlaneDistance(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b) {
+  return std::hypot(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]));
+}
+
+double StrokeLength(const Stroke& s) {
+  double length = 0;
+  for (std::size_t k = 1; k < s.points.size(); ++k) length += PlaneDistance(s.points[k - 1], s.points[k]);
+  return length;
+}
+
+double Travel(const std::vector<Stroke>& strokes) {
+  std::array<std::int64_t, 3> pen{0, 0, 0};
+  double travel = 0;
+  for (const Stroke& s : strokes) {
+    travel += PlaneDistance(pen, s.points.front());
+    pen = s.points.back();
+  }
+  return travel;
+}
+
+void Reverse(Stroke* s) {
+  std::reverse(s->points.begin(), s->points.end());
+  std::reverse(s->params.begin(), s->params.end());
+}
+
+}  // namespace
+
+View ParseView(const std::string& text, const std::string& what) {
+  View v;
+  v.name = text;
+  if (text == "top") {
+    v.right = {1, 0, 0};
+    v.up = {0, 1, 0};
+  } else if (text == "front") {
+    v.right = {1, 0, 0};
+    v.up = {0, 0, 1};
+  } else if (text == "side") {
+    v.right = {0, 1, 0};
+    v.up = {0, 0, 1};
+  } else if (text == "iso") {
+    return ViewFromAngles(text, -45, std::atan(1 / std::sqrt(2.0)) * 180 / kPi);
+  } else {
+    const std::size_t comma = text.find(',');
+    double az = 0, el = 0;
+    std::size_t used_az = 0, used_el = 0;
+    bool ok = comma != std::string::npos;
+    try {
+      if (ok) {
+        az = std::stod(text.substr(0, comma), &used_az);
+        el = std::stod(text.substr(comma + 1), &used_el);
+      }
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    ok = ok && used_az == comma && used_el == text.size() - comma - 1 && std::isfinite(az) &&
+         std::isfinite(el);
+    if (!ok) {
+      throw InputError(what + ": '" + text +
+                       "' is not a view: use top, front, side, iso or AZ,EL in degrees");
+    }
+    if (el < -90 || el > 90) {
+      throw InputError(what + ": elevation " + Number(el) + " is outside -90..90 degrees");
+    }
+    return ViewFromAngles(text, az, el);
+  }
+  v.depth = Cross(v.right, v.up);
+  return v;
+}
+
+std::array<double, 3> OutputMap::ApplyLinear(const Point3& p) const {
+  return {scale * Dot(view.right, p), scale * Dot(view.up, p), scale * Dot(view.depth, p)};
+}
+
+std::array<double, 3> OutputMap::Apply(const Point3& p) const {
+  auto out = ApplyLinear(p);
+  for (int c = 0; c < 3; ++c) out[c] += offset[c];
+  return out;
+}
+
+Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, const std::string& units,
+                       const Progress& progress) {
+  if (options.lines_s == 1 || options.lines_t == 1 || options.lines_s < 0 || options.lines_t < 0 ||
+      options.lines_s > kMaxPatchSteps + 1 || options.lines_t > kMaxPatchSteps + 1) {
+    throw InputError("--lines: each count must be 0 (family left out) or 2.." +
+                     std::to_string(kMaxPatchSteps + 1));
+  }
+  if (options.lines_s == 0 && options.lines_t == 0) {
+    throw InputError("--lines: both families are left out; nothing to draw");
+  }
+  const double needed = std::sqrt(static_cast<double>(options.dims)) * (0.5 + 1.0 / 1024) *
+                        options.quantum.value();
+  if (!(options.tolerance > needed * 1.003)) {
+    throw InputError("--tolerance " + Number(options.tolerance) + " " + units +
+                     " is too small: with points rounded to the quantum " +
+                     options.quantum.Format(1) + " " + units + " it must exceed " + Number(needed * 1.003) +
+                     " " + units + " (√" + std::to_string(options.dims) + "·0.501 quanta)");
+  }
+  if (set.patches.empty()) throw InputError("the file has no patches to draw");
+
+  Toolpath path;
+  path.dims = options.dims;
+  path.units = units;
+  path.quantum = options.quantum;
+  path.map.view = options.view;
+
+  const Box box = DrawingBox(set, options);
+  const double bw = box.hi[0] - box.lo[0];
+  const double bh = box.hi[1] - box.lo[1];
+  double scale = options.units_scale;
+  if (options.fit) {
+    const double w = (*options.fit)[0] - 2 * options.margin;
+    const double h = (*options.fit)[1] - 2 * options.margin;
+    if (!(w > 0 && h > 0)) {
+      throw InputError("--fit: the page " + Number((*options.fit)[0]) + "x" + Number((*options.fit)[1]) +
+                       " leaves no room inside the margin of " + Number(options.margin));
+    }
+    if (bw <= 0 && bh <= 0) throw InputError("--fit: the drawing is a single point in this view");
+    scale = std::min(bw > 0 ? w / bw : HUGE_VAL, bh > 0 ? h / bh : HUGE_VAL);
+    path.width = (*options.fit)[0];
+    path.height = (*options.fit)[1];
+  } else {
+    path.width = bw * scale + 2 * options.margin;
+    path.height = bh * scale + 2 * options.margin;
+  }
+  path.map.scale = scale;
+  path.map.offset = {(path.width - bw * scale) / 2 - box.lo[0] * scale,
+                     (path.height - bh * scale) / 2 - box.lo[1] * scale,
+                     options.dims == 3 ? -box.hi[2] * scale : 0.0};
+
+  for (std::size_t p = 0; p < set.patches.size(); ++p) {
+    if (options.dims == 3) {
+      DrawPatch<3>(set.patches[p], p, path.map, options, &path.strokes);
+    } else {
+      DrawPatch<2>(set.patches[p], p, path.map, options, &path.strokes);
+    }
+    if (progress) {
+      std::size_t points = 0;
+      for (const Stroke& s : path.strokes) points += s.points.size();
+      progress(p + 1, set.patches.size(), points);
+    }
+  }
+  return path;
+}
+
+std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path, const Stroke& stroke,
+                                       double param) {
+  const Patch& patch = set.patches[stroke.patch];
+  const Point3 p = stroke.family == IsolineFamily::kSLines
+                       ? EvaluateReference(patch, stroke.line_param, param)
+                       : EvaluateReference(patch, param, stroke.line_param);
+  auto out = path.map.Apply(p);
+  if (path.dims == 2) out[2] = 0;
+  return out;
+}
+
+PlanReport PlanStrokes(Toolpath* path) {
+  PlanReport report;
+  std::vector<Stroke>& strokes = path->strokes;
+  const double q = path->quantum.value();
+  report.strokes_before = strokes.size();
+  for (const Stroke& s : strokes) report.pen_down_before += StrokeLength(s) * q;
+  report.pen_up_before = Travel(strokes) * q;
+
+  // 1. Strokes drawn twice: patches that share an edge both draw it.
+  std::set<std::vector<std::array<std::int64_t, 3>>> seen;
+  std::vector<Stroke> unique;
+  for (Stroke& s : strokes) {
+    auto reversed = s.points;
+    std::reverse(reversed.begin(), reversed.end());
+    const auto& key = std::min(s.points, reversed);
+    if (!seen.insert(key).second) {
+      ++report.duplicates_removed;
+      continue;
+    }
+    unique.push_back(std::move(s));
+  }
+
+  // 2. Join strokes that meet end to end into one pen-down stroke.
+  std::multimap<std::array<std::int64_t, 3>, std::size_t> ends;
+  for (std::size_t i = 0; i < unique.size(); ++i) {
+    ends.emplace(unique[i].points.front(), i);
+    ends.emplace(unique[i].points.back(), i);
+  }
+  std::vector<bool> used(unique.size(), false);
+  const auto take_at = [&](const std::array<std::int64_t, 3>& point) -> std::ptrdiff_t {
+    auto [lo, hi] = ends.equal_range(point);
+    for (auto it = lo; it != hi; ++it) {
+      if (!used[it->second]) return static_cast<std::ptrdiff_t>(it->second);
+    }
+    return -1;
+  };
+  std::vector<Stroke> joined;
+  for (std::size_t i = 0; i < unique.size(); ++i) {
+    if (used[i]) continue;
+    used[i] = true;
+    Stroke chain = std::move(unique[i]);
+    for (int side = 0; side < 2; ++side) {
+      for (;;) {
+        const std::ptrdiff_t next = take_at(chain.points.back());
+        if (next < 0) break;
+        used[next] = true;
+        Stroke& other = unique[next];
+        if (other.points.front() != chain.points.back()) Reverse(&other);
+        chain.points.insert(chain.points.end(), other.points.begin() + 1, other.points.end());
+      }
+      Reverse(&chain);  // then extend the other end
+    }
+    chain.params.clear();  // a joined stroke spans several curves
+    joined.push_back(std::move(chain));
+  }
+
+  // 3. Order: nearest neighbour from the origin, reversing where it helps.
+  std::vector<Stroke> ordered;
+  std::vector<bool> placed(joined.size(), false);
+  std::array<std::int64_t, 3> pen{0, 0, 0};
+  for (std::size_t n = 0; n < joined.size(); ++n) {
+    double best = HUGE_VAL;
+    std::size_t best_index = 0;
+    bool best_reversed = false;
+    for (std::size_t i = 0; i < joined.size(); ++i) {
+      if (placed[i]) continue;
+      const double to_front = PlaneDistance(pen, joined[i].points.front());
+      const double to_back = PlaneDistance(pen, joined[i].points.back());
+      if (to_front < best) {
+        best = to_front;
+        best_index = i;
+        best_reversed = false;
+      }
+      if (to_back < best) {
+        best = to_back;
+        best_index = i;
+        best_reversed = true;
+      }
+    }
+    placed[best_index] = true;
+    if (best_reversed) Reverse(&joined[best_index]);
+    pen = joined[best_index].points.back();
+    ordered.push_back(std::move(joined[best_index]));
+  }
+
+  // 4. 2-opt: reversing the run i..j (and each stroke in it) replaces the
+  // links exit(i-1)→entry(i) and exit(j)→entry(j+1) by exit(i-1)→exit(j) and
+  // entry(i)→entry(j+1). A window keeps large drawings fast.
+  const std::size_t n = ordered.size();
+  const auto exit_of = [&](std::size_t k) {
+    return k == 0 ? std::array<std::int64_t, 3>{0, 0, 0} : ordered[k - 1].points.back();
+  };
+  constexpr std::size_t kWindow = 300;
+  for (int pass = 0; pass < 30; ++pass) {
+    bool improved = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto before = exit_of(i);
+      for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
+        const double old_links = PlaneDistance(before, ordered[i].points.front()) +
+                                 (j + 1 < n ? PlaneDistance(ordered[j].points.back(), ordered[j + 1].points.front()) : 0);
+        const double new_links = PlaneDistance(before, ordered[j].points.back()) +
+                                 (j + 1 < n ? PlaneDistance(ordered[i].points.front(), ordered[j + 1].points.front()) : 0);
+        if (new_links < old_links - 1e-9) {
+          std::reverse(ordered.begin() + static_cast<std::ptrdiff_t>(i),
+                       ordered.begin() + static_cast<std::ptrdiff_t>(j) + 1);
+          for (std::size_t k = i; k <= j; ++k) Reverse(&ordered[k]);
+          improved = true;
+        }
+      }
+    }
+    if (!improved) break;
+  }
+
+  strokes = std::move(ordered);
+  report.strokes_after = strokes.size();
+  for (const Stroke& s : strokes) report.pen_down_after += StrokeLength(s) * q;
+  report.pen_up_after = Travel(strokes) * q;
+  return report;
+}
+
+}  // namespace fdsurf::host

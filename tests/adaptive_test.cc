@@ -1,0 +1,337 @@
+// Adaptive forward differencing and the isoline walker against exact and
+// independent references: every point is the exactly rounded value of the
+// prepared curve, every chord is within the tolerance of the original curve
+// (measured densely in long double), step-exact paths move at most one
+// quantum per axis, and the walker's line coefficients are exact.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "exact_reference.h"
+#include "fdsurf/adaptive.h"
+
+namespace fdsurf {
+namespace {
+
+using testing::I128;
+
+constexpr double kOneQuantumRaw = 65536.0;
+
+struct Emitted {
+  std::uint32_t position;
+  std::array<std::int32_t, 3> point;
+};
+
+template <typename Acc>
+std::vector<Emitted> StepAll(const PreparedAdaptiveCurve<3>& curve) {
+  std::vector<Emitted> out;
+  AdaptiveCurveStepper<Acc, 3>(curve).ForEachPoint(
+      [&out](std::uint32_t position, const std::int32_t (&p)[3]) {
+        out.push_back({position, {p[0], p[1], p[2]}});
+      });
+  return out;
+}
+
+std::vector<Emitted> StepAll(const PreparedAdaptiveCurve<3>& curve) {
+  return curve.format.acc_bits == 64 ? StepAll<std::int64_t>(curve) : StepAll<Int128>(curve);
+}
+
+// A random cubic in quanta whose values stay within about ±range.
+struct DoubleCubic {
+  double c[3][4];  // per axis a, b, c, d
+};
+
+DoubleCubic RandomCubic(std::mt19937_64& rng, double range) {
+  std::uniform_real_distribution<double> dist(-range, range);
+  DoubleCubic cubic;
+  for (auto& axis : cubic.c) {
+    // From 4 random values at t = 0, 1/3, 2/3, 1 (a Lagrange cubic): realistic
+    // curves, with coefficients up to ~20× the range.
+    const double y0 = dist(rng), y1 = dist(rng), y2 = dist(rng), y3 = dist(rng);
+    axis[0] = 4.5 * (-y0 + 3 * y1 - 3 * y2 + y3);
+    axis[1] = 4.5 * (2 * y0 - 5 * y1 + 4 * y2 - y3);
+    axis[2] = -5.5 * y0 + 9 * y1 - 4.5 * y2 + y3;
+    axis[3] = y0;
+  }
+  return cubic;
+}
+
+void ToRaw(const DoubleCubic& cubic, PowerCurve1 (&raw)[3]) {
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 4; ++k) {
+      raw[c].c[k] = static_cast<std::int64_t>(std::nearbyint(cubic.c[c][k] * kOneQuantumRaw));
+    }
+  }
+}
+
+long double Evaluate(const double (&axis)[4], long double t) {
+  return ((axis[0] * t + axis[1]) * t + axis[2]) * t + axis[3];
+}
+
+// Euclidean distance from p to the segment [a, b].
+long double DistanceToSegment(const std::array<long double, 3>& p, const std::array<long double, 3>& a,
+                              const std::array<long double, 3>& b) {
+  long double ab2 = 0, ap_ab = 0;
+  for (int c = 0; c < 3; ++c) {
+    ab2 += (b[c] - a[c]) * (b[c] - a[c]);
+    ap_ab += (p[c] - a[c]) * (b[c] - a[c]);
+  }
+  const long double u = ab2 > 0 ? std::clamp(ap_ab / ab2, 0.0L, 1.0L) : 0.0L;
+  long double d2 = 0;
+  for (int c = 0; c < 3; ++c) {
+    const long double q = a[c] + u * (b[c] - a[c]);
+    d2 += (p[c] - q) * (p[c] - q);
+  }
+  return std::sqrt(d2);
+}
+
+// The largest distance of the original curve from the emitted polyline, per
+// chord, sampled densely in the chord's parameter interval; and of each
+// emitted point from the curve at its parameter.
+long double WorstDeviation(const DoubleCubic& cubic, const std::vector<Emitted>& points, int level) {
+  long double worst = 0;
+  const long double scale = std::ldexp(1.0L, -level);
+  for (size_t k = 0; k < points.size(); ++k) {
+    std::array<long double, 3> a{};
+    for (int c = 0; c < 3; ++c) a[c] = points[k].point[c];
+    const long double ta = points[k].position * scale;
+    long double d2 = 0;
+    for (int c = 0; c < 3; ++c) d2 += std::pow(Evaluate(cubic.c[c], ta) - a[c], 2);
+    worst = std::max(worst, std::sqrt(d2));
+    if (k + 1 == points.size()) break;
+    std::array<long double, 3> b{};
+    for (int c = 0; c < 3; ++c) b[c] = points[k + 1].point[c];
+    const long double tb = points[k + 1].position * scale;
+    constexpr int kSamples = 24;
+    for (int i = 1; i < kSamples; ++i) {
+      const long double t = ta + (tb - ta) * i / kSamples;
+      std::array<long double, 3> p{};
+      for (int c = 0; c < 3; ++c) p[c] = Evaluate(cubic.c[c], t);
+      worst = std::max(worst, DistanceToSegment(p, a, b));
+    }
+  }
+  return worst;
+}
+
+// Exact value of the prepared (rounded-coefficient) curve at position/2^L is
+// rounded to `k`: |k − x| ≤ 1/2 with x = Σ coef·pos^(3-j)·2^(jL) / 2^(3L+16).
+bool IsExactlyRounded(const PowerCurve1& raw, std::uint32_t position, int level, std::int32_t k) {
+  const I128 p = position;
+  const I128 num = raw.c[0] * p * p * p + (raw.c[1] * p * p << level) +
+                   (raw.c[2] * p << (2 * level)) + (I128(raw.c[3]) << (3 * level));
+  const I128 den = I128(1) << (3 * level + 16);
+  I128 diff = I128(k) * den - num;
+  if (diff < 0) diff = -diff;
+  return 2 * diff <= den;
+}
+
+TEST(AdaptiveCurve, EveryPointIsTheExactlyRoundedValueAndEveryChordIsWithinTolerance) {
+  std::mt19937_64 rng(20261122);
+  const double tolerances[] = {1.0, 2.5, 10.0, 200.0};
+  for (int trial = 0; trial < 400; ++trial) {
+    const double range = std::ldexp(1.0, 4 + trial % 16);  // up to 2^19 quanta
+    const DoubleCubic cubic = RandomCubic(rng, range);
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    const double tolerance = tolerances[trial % 4];
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = static_cast<std::uint32_t>(tolerance * 256);
+    PreparedAdaptiveCurve<3> curve;
+    ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk) << trial;
+    const auto points = StepAll(curve);
+    ASSERT_GE(points.size(), 2u);
+    EXPECT_EQ(points.front().position, 0u);
+    EXPECT_EQ(points.back().position, std::uint32_t{1} << curve.finest_level);
+    for (size_t k = 0; k < points.size(); ++k) {
+      if (k > 0) {
+        ASSERT_GT(points[k].position, points[k - 1].position);
+      }
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_TRUE(IsExactlyRounded(raw[c], points[k].position, curve.finest_level,
+                                     points[k].point[c]))
+            << "trial " << trial << " point " << k << " axis " << c;
+      }
+    }
+    EXPECT_LE(WorstDeviation(cubic, points, curve.finest_level), tolerance)
+        << "trial " << trial << " tolerance " << tolerance;
+  }
+}
+
+TEST(AdaptiveCurve, BothAccumulatorsEmitTheSameBits) {
+  std::mt19937_64 rng(7);
+  int compared = 0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const DoubleCubic cubic = RandomCubic(rng, std::ldexp(1.0, 6 + trial % 12));
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = 3 * 256;
+    settings.mode = trial % 2 == 0 ? AdaptiveMode::kTolerance : AdaptiveMode::kStepExact;
+    PreparedAdaptiveCurve<3> curve;
+    ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk);
+    if (curve.format.acc_bits != 64) continue;
+    ++compared;
+    const auto narrow = StepAll<std::int64_t>(curve);
+    const auto wide = StepAll<Int128>(curve);
+    ASSERT_EQ(narrow.size(), wide.size());
+    for (size_t k = 0; k < narrow.size(); ++k) {
+      EXPECT_EQ(narrow[k].position, wide[k].position);
+      EXPECT_EQ(narrow[k].point, wide[k].point);
+    }
+  }
+  EXPECT_GT(compared, 20);
+}
+
+TEST(AdaptiveCurve, StepExactPathsMoveAtMostOneQuantumPerAxisAndNeverRepeat) {
+  std::mt19937_64 rng(99);
+  for (int trial = 0; trial < 60; ++trial) {
+    const DoubleCubic cubic = RandomCubic(rng, std::ldexp(1.0, 3 + trial % 10));
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = 2 * 256;
+    settings.mode = AdaptiveMode::kStepExact;
+    PreparedAdaptiveCurve<3> curve;
+    ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk);
+    const auto points = StepAll(curve);
+    for (size_t k = 1; k < points.size(); ++k) {
+      int moved = 0;
+      for (int c = 0; c < 3; ++c) {
+        const int delta = points[k].point[c] - points[k - 1].point[c];
+        ASSERT_LE(std::abs(delta), 1) << "trial " << trial << " point " << k;
+        moved += delta != 0;
+      }
+      ASSERT_GT(moved, 0) << "repeated point, trial " << trial;
+    }
+    EXPECT_LE(WorstDeviation(cubic, points, curve.finest_level), 2.0) << trial;
+  }
+}
+
+TEST(AdaptiveCurve, AStraightLineIsOneChord) {
+  const DoubleCubic line{{{0, 0, 1000, -3}, {0, 0, -250.5, 7}, {0, 0, 0, 1}}};
+  PowerCurve1 raw[3];
+  ToRaw(line, raw);
+  AdaptiveSettings settings;
+  settings.tolerance_q8 = 256;
+  PreparedAdaptiveCurve<3> curve;
+  ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk);
+  EXPECT_EQ(StepAll(curve).size(), 2u);
+}
+
+// For y = b·t² the chord deviation at step h is b·h²/4 exactly, so the fewest
+// uniform steps are N = ceil(sqrt(b/(4·budget))); power-of-two adaptation may
+// need up to twice that, never more.
+TEST(AdaptiveCurve, PointCountIsWithinTwiceTheUniformOptimumOnAParabola) {
+  for (double b : {50.0, 1e3, 3e4, 1e6}) {
+    const DoubleCubic parabola{{{0, 0, 100, 0}, {0, b, 0, 0}, {0, 0, 0, 0}}};
+    PowerCurve1 raw[3];
+    ToRaw(parabola, raw);
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = 4 * 256;
+    PreparedAdaptiveCurve<3> curve;
+    ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk);
+    const double budget = 4.0 / std::sqrt(3.0) - 0.5 - 1.0 / 1024;
+    const double optimum = std::ceil(std::sqrt(b / (4 * budget)));
+    const auto steps = static_cast<double>(StepAll(curve).size() - 1);
+    EXPECT_LE(steps, 2 * optimum) << b;
+    EXPECT_GE(steps, optimum / 1.3) << b;  // the √3 norm factor costs at most √(√3)
+  }
+}
+
+TEST(AdaptiveCurve, RefusesWhatItCannotServe) {
+  PowerCurve1 raw[3] = {{{1 << 20, 5, 6, 7}}, {{0, 0, 0, 0}}, {{0, 0, 0, 0}}};
+  PreparedAdaptiveCurve<3> curve;
+  AdaptiveSettings settings;
+  settings.tolerance_q8 = 222;  // 0.867 quanta < √3·(0.5 + 2^-10) = 0.8677
+  EXPECT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kToleranceUnreachable);
+  settings.tolerance_q8 = 224;  // 0.875 quanta: enough with the rounded-down 1/√3
+  EXPECT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk);
+
+  PowerCurve1 huge[3] = {{{std::int64_t{1} << 46, std::int64_t{1} << 46, 0, 0}}, {}, {}};
+  settings.tolerance_q8 = 256;
+  EXPECT_EQ(PrepareAdaptiveCurve(huge, settings, &curve), Status::kGeometryOutOfRange);
+
+  // A step-exact path over ±2^30 quanta would need steps below 2^-30.
+  PowerCurve1 fast[3] = {{{0, 0, std::int64_t{1} << 46, 0}}, {}, {}};
+  settings.mode = AdaptiveMode::kStepExact;
+  EXPECT_EQ(PrepareAdaptiveCurve(fast, settings, &curve), Status::kPrecisionUnreachable);
+  // ... and over ±2^20 quanta it needs the 128-bit accumulator.
+  PowerCurve1 medium[3] = {{{0, 0, std::int64_t{1} << 36, 0}}, {}, {}};
+  settings.max_acc_bits = 64;
+  EXPECT_EQ(PrepareAdaptiveCurve(medium, settings, &curve), Status::kPrecisionUnreachable);
+  settings.max_acc_bits = 128;
+  ASSERT_EQ(PrepareAdaptiveCurve(medium, settings, &curve), Status::kOk);
+  EXPECT_EQ(curve.format.acc_bits, 128);
+}
+
+// Walker coefficients against the exact rational line: for an s-line at
+// s = i/n, coefficient l of t^(3-l) is Σ_r Σ_c w_s[r]·g[r][c]·(dM)[l][c] / (d²n³).
+TEST(IsolineWalker, LineCoefficientsAreTheExactlyRoundedOnes) {
+  std::mt19937_64 rng(5);
+  const Basis bases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline,
+                         Basis::kCatmullRom};
+  std::uniform_int_distribution<std::int64_t> dist(-(std::int64_t{1} << 36), std::int64_t{1} << 36);
+  for (int trial = 0; trial < 60; ++trial) {
+    const Basis basis = bases[trial % 5];
+    const auto& b = testing::TestBasisFor(static_cast<int>(basis));
+    PatchGeometry1 geometry[3];
+    std::int64_t g[3][4][4];
+    for (int c = 0; c < 3; ++c) {
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+          g[c][i][j] = dist(rng);
+          geometry[c].g[i][j] = GeometryFixed::FromRaw(g[c][i][j]);
+        }
+      }
+    }
+    const int lines = 2 + trial * 17 % 40;
+    const int n = lines - 1;
+    for (IsolineFamily family : {IsolineFamily::kSLines, IsolineFamily::kTLines}) {
+      IsolineWalker<3> walker;
+      ASSERT_EQ(IsolineWalker<3>::Create(geometry, basis, family, static_cast<std::uint16_t>(lines),
+                                         &walker),
+                Status::kOk);
+      PowerCurve1 curve[3];
+      for (int i = 0; i < lines; ++i) {
+        ASSERT_TRUE(walker.Next(curve));
+        const auto w = testing::ScaledWeights(b, i, n);
+        for (int c = 0; c < 3; ++c) {
+          for (int l = 0; l < 4; ++l) {
+            I128 num = 0;
+            for (int r = 0; r < 4; ++r) {
+              for (int q = 0; q < 4; ++q) {
+                num += family == IsolineFamily::kSLines ? w[r] * g[c][r][q] * b.m[l][q]
+                                                        : w[q] * g[c][r][q] * b.m[l][r];
+              }
+            }
+            const I128 den = I128(b.denominator) * b.denominator * n * n * n;
+            I128 diff = I128(curve[c].c[l]) * den - num;
+            if (diff < 0) diff = -diff;
+            ASSERT_LE(2 * diff, den) << "trial " << trial << " line " << i << " coef " << l;
+          }
+        }
+      }
+      EXPECT_FALSE(walker.Next(curve));
+    }
+  }
+}
+
+TEST(IsolineWalker, RefusesBadLineCounts) {
+  PatchGeometry1 geometry[2] = {};
+  IsolineWalker<2> walker;
+  EXPECT_EQ(IsolineWalker<2>::Create(geometry, Basis::kBezier, IsolineFamily::kSLines, 1, &walker),
+            Status::kGridOutOfRange);
+  EXPECT_EQ(IsolineWalker<2>::Create(geometry, Basis::kBezier, IsolineFamily::kSLines,
+                                     kMaxPatchSteps + 2, &walker),
+            Status::kGridOutOfRange);
+  EXPECT_EQ(IsolineWalker<2>::Create(geometry, static_cast<Basis>(9), IsolineFamily::kSLines, 4,
+                                     &walker),
+            Status::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace fdsurf
