@@ -187,5 +187,54 @@ TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
   ExpectRefused("sample '" + empty + "' --grid 4", "e.bpt:1: file ends where the number");
 }
 
+// Bad plot options: a clear message, a non-zero exit, and no output file at
+// all (not even an empty or partial one).
+TEST_F(Cli, PlotRefusesBadOptionsAndLeavesNoFile) {
+  const std::string out = (dir_ / "out.svg").string();
+  const auto refused = [&](const std::string& args, const std::string& part) {
+    ExpectRefused("plot '" + kTeapot + "' -o '" + out + "' " + args, part);
+    EXPECT_FALSE(fs::exists(out)) << args;
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      EXPECT_EQ(entry.path().filename().string().find("out.svg"), std::string::npos) << args;
+    }
+  };
+  refused("--tolerance -0.1", "--tolerance: '-0.1' must be greater than zero");
+  refused("--tolerance abc", "--tolerance: 'abc' is not a number");
+  refused("--tolerance 0.0005", "--tolerance 0.0005 mm is too small");
+  refused("--view diagonal", "--view: 'diagonal' is not a view");
+  refused("--view 10,100", "elevation 100 is outside -90..90");
+  refused("--lines 1", "--lines: '1' is not U or UxV");
+  refused("--lines 0x0", "both families are left out");
+  refused("--fit 20x10 --margin 10", "--fit: the page 20x10 leaves no room");
+  refused("--fit 20", "--fit: '20' is not WxH");
+  refused("--dims 3", "--dims 3: only G-code and JSON carry a third axis");
+  refused("--format hpgl --quantum 0.01", "HPGL positions are plotter units");
+  ExpectRefused("plot '" + kTeapot + "' -o '" + (dir_ / "missing" / "out.svg").string() + "'",
+                "missing/out.svg.fdsurf-");
+  ExpectRefused("plot '" + kTeapot + "' -o '" + out + "' --png '" + (dir_ / "no" / "t.png").string() + "'",
+                "t.png");
+  EXPECT_FALSE(fs::exists(out));  // the SVG is not written when the PNG cannot be
+  ExpectRefused("render '" + kTeapot + "'", "--output is required");
+}
+
+TEST_F(Cli, PlotWritesEachFormat) {
+  for (const char* format : {"svg", "gcode", "hpgl", "json"}) {
+    const std::string out = (dir_ / (std::string("teapot.") + format)).string();
+    const RunResult r = Run("plot '" + kTeapot + "' -o '" + out + "' --lines 4 --fit 150x100");
+    EXPECT_EQ(r.exit_code, 0) << format << r.err;
+    EXPECT_NE(r.err.find("wrote " + out + " (" + format), std::string::npos) << r.err;
+    EXPECT_GT(fs::file_size(out), 1000u) << format;
+  }
+  const RunResult render = Run("render '" + kTeapot + "' -o '" + (dir_ / "t.png").string() + "' --size 300");
+  EXPECT_EQ(render.exit_code, 0) << render.err;
+  const std::string png = Slurp(dir_ / "t.png");
+  ASSERT_GT(png.size(), 8u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  // Every output went through a temporary that is gone afterwards.
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+}
+
 }  // namespace
 }  // namespace fdsurf::host

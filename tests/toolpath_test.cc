@@ -1,0 +1,254 @@
+// Toolpaths against the double reference: every emitted point and every chord
+// of every isoline within the tolerance of the exact curve (measured densely),
+// for the teapot and random patches of every basis, in several views, in 2-D
+// and 3-D, in each stepping mode; and path planning that keeps every drawn
+// segment while cutting pen-up travel.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/toolpath.h"
+
+namespace fdsurf::host {
+namespace {
+
+using Vec = std::array<double, 3>;
+
+double Distance(const Vec& a, const Vec& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+double DistanceToSegment(const Vec& p, const Vec& a, const Vec& b) {
+  double ab2 = 0, dot = 0;
+  for (int c = 0; c < 3; ++c) {
+    ab2 += (b[c] - a[c]) * (b[c] - a[c]);
+    dot += (p[c] - a[c]) * (b[c] - a[c]);
+  }
+  const double u = ab2 > 0 ? std::clamp(dot / ab2, 0.0, 1.0) : 0.0;
+  Vec q{};
+  for (int c = 0; c < 3; ++c) q[c] = a[c] + u * (b[c] - a[c]);
+  return Distance(p, q);
+}
+
+struct Deviation {
+  double points = 0;  // largest distance of an emitted point from the curve at its parameter
+  double chords = 0;  // largest distance of the curve from its chord, sampled densely
+};
+
+Deviation Measure(const PatchSet& set, const Toolpath& path) {
+  Deviation worst;
+  const double q = path.quantum.value();
+  for (const Stroke& s : path.strokes) {
+    std::vector<Vec> points;
+    for (const auto& p : s.points) points.push_back({p[0] * q, p[1] * q, p[2] * q});
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      worst.points = std::max(worst.points, Distance(points[k], ExactStrokePoint(set, path, s, s.params[k])));
+      if (k + 1 == points.size()) break;
+      constexpr int kSamples = 16;
+      for (int i = 1; i < kSamples; ++i) {
+        const double u = s.params[k] + (s.params[k + 1] - s.params[k]) * i / kSamples;
+        worst.chords =
+            std::max(worst.chords, DistanceToSegment(ExactStrokePoint(set, path, s, u), points[k], points[k + 1]));
+      }
+    }
+  }
+  return worst;
+}
+
+PatchSet Teapot() { return ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/teapot.bpt"); }
+
+PatchSet RandomPatches(std::mt19937_64& rng) {
+  PatchSet set;
+  set.units = "mm";
+  std::uniform_real_distribution<double> dist(-40, 40);
+  const Basis bases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline, Basis::kCatmullRom};
+  for (Basis basis : bases) {
+    Patch patch;
+    patch.basis = basis;
+    patch.origin = "random";
+    for (auto& row : patch.g) {
+      for (auto& p : row) p = {dist(rng), dist(rng), dist(rng)};
+    }
+    set.patches.push_back(patch);
+  }
+  return set;
+}
+
+ToolpathOptions Options(const std::string& view, double tolerance, int dims, StepMode mode) {
+  ToolpathOptions o;
+  o.view = ParseView(view);
+  o.tolerance = tolerance;
+  o.dims = dims;
+  o.mode = mode;
+  o.lines_s = 5;
+  o.lines_t = 4;
+  o.quantum = Quantum::Parse("0.001");
+  return o;
+}
+
+TEST(Toolpath, EveryPointAndChordOfTheTeapotIsWithinTolerance) {
+  const PatchSet set = Teapot();
+  struct Case {
+    const char* view;
+    double tolerance;
+    int dims;
+    StepMode mode;
+    const char* quantum;
+  };
+  const Case cases[] = {
+      {"iso", 0.05, 2, StepMode::kAdaptive, "0.001"},  {"top", 0.01, 2, StepMode::kAdaptive, "0.001"},
+      {"30,60", 0.2, 3, StepMode::kAdaptive, "0.001"}, {"front", 0.05, 2, StepMode::kFixed, "0.001"},
+      {"side", 0.05, 3, StepMode::kFixed, "0.001"},    {"iso", 0.04, 2, StepMode::kAdaptive, "0.025"},
+      {"iso", 0.02, 2, StepMode::kStepExact, "0.01"},
+  };
+  for (const Case& c : cases) {
+    ToolpathOptions o = Options(c.view, c.tolerance, c.dims, c.mode);
+    o.quantum = Quantum::Parse(c.quantum);
+    o.fit = std::array<double, 2>{200, 150};
+    const Toolpath path = BuildToolpath(set, o, "mm");
+    const Deviation d = Measure(set, path);
+    EXPECT_LE(d.points, c.tolerance) << c.view << " " << c.tolerance;
+    EXPECT_LE(d.chords, c.tolerance) << c.view << " " << c.tolerance;
+    // The bound is not slack: the drawing uses a good part of it.
+    EXPECT_GE(d.chords, 0.2 * c.tolerance) << c.view << " " << c.tolerance;
+  }
+}
+
+TEST(Toolpath, RandomPatchesOfEveryBasisStayWithinTolerance) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 8; ++trial) {
+    const PatchSet set = RandomPatches(rng);
+    for (StepMode mode : {StepMode::kAdaptive, StepMode::kFixed}) {
+      const double tolerance = trial % 2 == 0 ? 0.01 : 0.3;
+      const Toolpath path = BuildToolpath(set, Options(trial % 3 == 0 ? "iso" : "-20,10", tolerance,
+                                                       2 + trial % 2, mode), "mm");
+      const Deviation d = Measure(set, path);
+      EXPECT_LE(d.points, tolerance) << trial;
+      EXPECT_LE(d.chords, tolerance) << trial;
+    }
+  }
+}
+
+TEST(Toolpath, StepExactPathsMoveOneQuantumAtATime) {
+  const PatchSet set = Teapot();
+  ToolpathOptions o = Options("iso", 0.03, 2, StepMode::kStepExact);
+  o.quantum = Quantum::Parse("0.01");
+  o.fit = std::array<double, 2>{100, 80};
+  const Toolpath path = BuildToolpath(set, o, "mm");
+  for (const Stroke& s : path.strokes) {
+    for (std::size_t k = 1; k < s.points.size(); ++k) {
+      ASSERT_LE(std::abs(s.points[k][0] - s.points[k - 1][0]), 1);
+      ASSERT_LE(std::abs(s.points[k][1] - s.points[k - 1][1]), 1);
+      ASSERT_NE(s.points[k], s.points[k - 1]);
+    }
+  }
+}
+
+TEST(Toolpath, AdaptiveNeedsFewerPointsThanFixedStepsForTheSameTolerance) {
+  const PatchSet set = Teapot();
+  for (double tolerance : {0.01, 0.05, 0.2}) {
+    ToolpathOptions o = Options("iso", tolerance, 2, StepMode::kAdaptive);
+    o.fit = std::array<double, 2>{200, 150};
+    const auto count = [&](StepMode mode) {
+      o.mode = mode;
+      std::size_t n = 0;
+      for (const Stroke& s : BuildToolpath(set, o, "mm").strokes) n += s.points.size();
+      return n;
+    };
+    EXPECT_LT(count(StepMode::kAdaptive), count(StepMode::kFixed)) << tolerance;
+  }
+}
+
+TEST(Toolpath, FitPlacesTheDrawingInsideThePage) {
+  const PatchSet set = Teapot();
+  ToolpathOptions o = Options("iso", 0.05, 2, StepMode::kAdaptive);
+  o.fit = std::array<double, 2>{210, 297};
+  o.margin = 10;
+  const Toolpath path = BuildToolpath(set, o, "mm");
+  std::int64_t lo[2] = {INT64_MAX, INT64_MAX}, hi[2] = {INT64_MIN, INT64_MIN};
+  for (const Stroke& s : path.strokes) {
+    for (const auto& p : s.points) {
+      for (int c = 0; c < 2; ++c) {
+        lo[c] = std::min(lo[c], p[c]);
+        hi[c] = std::max(hi[c], p[c]);
+      }
+    }
+  }
+  const double q = path.quantum.value();
+  EXPECT_GE(lo[0] * q, 10 - q);
+  EXPECT_GE(lo[1] * q, 10 - q);
+  EXPECT_LE(hi[0] * q, 200 + q);
+  EXPECT_LE(hi[1] * q, 287 + q);
+  // Uniform scale: the width fills the page exactly (the teapot is wider than tall here).
+  // (within the tolerance: the polyline may cut inside an extreme of a curve).
+  EXPECT_NEAR((hi[0] - lo[0]) * q, 190, o.tolerance);
+}
+
+TEST(Toolpath, PlanningKeepsEverySegmentAndCutsTravel) {
+  const PatchSet set = Teapot();
+  ToolpathOptions o = Options("iso", 0.05, 2, StepMode::kAdaptive);
+  o.lines_s = o.lines_t = 6;
+  Toolpath path = BuildToolpath(set, o, "mm");
+  using Point = std::array<std::int64_t, 3>;
+  const auto segments = [](const Toolpath& p) {
+    std::set<std::pair<Point, Point>> out;
+    for (const Stroke& s : p.strokes) {
+      for (std::size_t k = 1; k < s.points.size(); ++k) {
+        out.insert(std::minmax(s.points[k - 1], s.points[k]));
+      }
+    }
+    return out;
+  };
+  const auto before = segments(path);
+  const PlanReport report = PlanStrokes(&path);
+  EXPECT_EQ(segments(path), before);
+  EXPECT_GT(report.duplicates_removed, 0u);  // the teapot's patches share edges
+  EXPECT_LT(report.strokes_after, report.strokes_before);
+  EXPECT_LT(report.pen_up_after, report.pen_up_before / 5);
+  EXPECT_LT(report.pen_down_after, report.pen_down_before);
+}
+
+TEST(Toolpath, ViewsAreRotations) {
+  const auto top = ParseView("top");
+  EXPECT_EQ(top.right, (std::array<double, 3>{1, 0, 0}));
+  EXPECT_EQ(top.up, (std::array<double, 3>{0, 1, 0}));
+  EXPECT_EQ(top.depth, (std::array<double, 3>{0, 0, 1}));
+  for (const char* name : {"iso", "30,45", "-120,-10", "0,90", "front", "side"}) {
+    const View v = ParseView(name);
+    const std::array<double, 3>* rows[3] = {&v.right, &v.up, &v.depth};
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        double dot = 0;
+        for (int c = 0; c < 3; ++c) dot += (*rows[a])[c] * (*rows[b])[c];
+        EXPECT_NEAR(dot, a == b ? 1 : 0, 1e-12) << name;
+      }
+    }
+  }
+  // front: x to the right, z up; side: y to the right, z up.
+  EXPECT_EQ(ParseView("front").up, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ(ParseView("side").right, (std::array<double, 3>{0, 1, 0}));
+  EXPECT_THROW(ParseView("diagonal"), InputError);
+  EXPECT_THROW(ParseView("10,95"), InputError);
+  EXPECT_THROW(ParseView("10,"), InputError);
+}
+
+TEST(Toolpath, RefusesWhatItCannotDraw) {
+  const PatchSet set = Teapot();
+  ToolpathOptions o = Options("iso", 0.0005, 2, StepMode::kAdaptive);
+  EXPECT_THROW(BuildToolpath(set, o, "mm"), InputError);  // below √2·0.5 quanta
+  o.tolerance = 0.05;
+  o.lines_s = o.lines_t = 0;
+  EXPECT_THROW(BuildToolpath(set, o, "mm"), InputError);
+  o.lines_s = 3;
+  o.fit = std::array<double, 2>{10, 10};
+  o.margin = 6;
+  EXPECT_THROW(BuildToolpath(set, o, "mm"), InputError);
+}
+
+}  // namespace
+}  // namespace fdsurf::host
