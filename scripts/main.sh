@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Sets everything up and runs fdsurf's main job on its default input, the Utah
-# teapot: checks the fixed-point engine against the double reference on a
-# 64x64 grid per patch and writes every grid point to build/teapot-64.csv.
+# Sets everything up and runs fdsurf's main job on its default input: draws
+# the Utah teapot (examples/teapot.bpt) as a wireframe of isolines, with
+# adaptive forward differences within 0.05 mm, as an SVG for a pen plotter
+# and a PNG to look at, both in build/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-./build/fdsurf check examples/teapot.bpt --grid 64
-./build/fdsurf sample examples/teapot.bpt --grid 64 > build/teapot-64.csv
-echo "wrote build/teapot-64.csv ($(($(wc -l < build/teapot-64.csv) - 1)) points)"
+./build/fdsurf plot examples/teapot.bpt --fit 200x150 -o build/teapot.svg --png build/teapot.png
+echo "open build/teapot.svg or build/teapot.png to see the drawing"

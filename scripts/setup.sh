@@ -10,7 +10,15 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   clang-format clang-tidy
+  libcairo2-dev
+  python3 hp2xx librsvg2-bin
 )
+# The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.
+# Debian's nodejs + npm provide node; a machine that already has a node with
+# npm bundled (e.g. from NodeSource) keeps it.
+if ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -21,6 +29,11 @@ if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+if [ ! -d tests/thirdparty/node_modules/gcode-toolpath ]; then
+  echo "setup: installing the npm packages of tests/thirdparty" >&2
+  npm ci --prefix tests/thirdparty --no-audit --no-fund --loglevel=error >/dev/null
 fi
 
 build_dir=${FDSURF_BUILD_DIR:-build}

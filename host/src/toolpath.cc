@@ -190,6 +190,9 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
       const auto add = [&](double param, const std::int32_t (&p)[kDims]) {
         std::array<std::int64_t, 3> point{0, 0, 0};
         for (int c = 0; c < kDims; ++c) point[c] = p[c];
+        // A repeated point draws nothing; the chord to the next point covers
+        // both parameter intervals (each is within the tolerance of it).
+        if (!stroke.points.empty() && stroke.points.back() == point) return;
         stroke.points.push_back(point);
         stroke.params.push_back(param);
       };
@@ -232,7 +235,8 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
           AdaptiveCurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
         }
       }
-      strokes->push_back(std::move(stroke));
+      // A line that collapses to a point (a pole, like the teapot lid's top) draws nothing.
+      if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
     }
   };
   draw_family(IsolineFamily::kSLines, options.lines_s);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <charconv>
 #include <cerrno>
 #include <cstdlib>
@@ -321,7 +322,11 @@ int RunPlot(const PlotOptions& o, bool render_only) {
   });
   if (progress) std::fputc('\n', stderr);
   std::size_t points = 0;
-  for (const Stroke& s : path.strokes) points += s.points.size();
+  std::size_t longest = 0;
+  for (const Stroke& s : path.strokes) {
+    points += s.points.size();
+    longest = std::max(longest, s.points.size());
+  }
   const std::size_t curves = path.strokes.size();
   PlanReport plan;
   if (o.plan) plan = PlanStrokes(&path);
@@ -355,9 +360,9 @@ int RunPlot(const PlotOptions& o, bool render_only) {
     outputs.Commit();
   }
   if (!o.quiet) {
-    std::fprintf(stderr, "%s: %zu patches, %zu curves, %zu points (%s, tolerance %s %s)\n", o.file.c_str(),
-                 set.patches.size(), curves, points, o.mode.c_str(), Number(t.tolerance).c_str(),
-                 work_units.c_str());
+    std::fprintf(stderr, "%s: %zu patches, %zu curves, %zu points, longest curve %zu (%s, tolerance %s %s)\n",
+                 o.file.c_str(), set.patches.size(), curves, points, longest, o.mode.c_str(),
+                 Number(t.tolerance).c_str(), work_units.c_str());
     if (o.plan) {
       std::fprintf(stderr,
                    "plan: %zu strokes -> %zu (%zu drawn twice removed); pen-down %.1f -> %.1f %s; "
