@@ -30,7 +30,7 @@ template <typename Acc>
 std::vector<Emitted> StepAll(const PreparedAdaptiveCurve<3>& curve) {
   std::vector<Emitted> out;
   AdaptiveCurveStepper<Acc, 3>(curve).ForEachPoint(
-      [&out](std::uint32_t position, const std::int32_t (&p)[3]) {
+      [&out](std::uint32_t position, const std::int32_t(&p)[3]) {
         out.push_back({position, {p[0], p[1], p[2]}});
       });
   return out;
@@ -73,7 +73,8 @@ long double Evaluate(const double (&axis)[4], long double t) {
 }
 
 // Euclidean distance from p to the segment [a, b].
-long double DistanceToSegment(const std::array<long double, 3>& p, const std::array<long double, 3>& a,
+long double DistanceToSegment(const std::array<long double, 3>& p,
+                              const std::array<long double, 3>& a,
                               const std::array<long double, 3>& b) {
   long double ab2 = 0, ap_ab = 0;
   for (int c = 0; c < 3; ++c) {
@@ -92,7 +93,8 @@ long double DistanceToSegment(const std::array<long double, 3>& p, const std::ar
 // The largest distance of the original curve from the emitted polyline, per
 // chord, sampled densely in the chord's parameter interval; and of each
 // emitted point from the curve at its parameter.
-long double WorstDeviation(const DoubleCubic& cubic, const std::vector<Emitted>& points, int level) {
+long double WorstDeviation(const DoubleCubic& cubic, const std::vector<Emitted>& points,
+                           int level) {
   long double worst = 0;
   const long double scale = std::ldexp(1.0L, -level);
   for (size_t k = 0; k < points.size(); ++k) {
@@ -151,8 +153,8 @@ TEST(AdaptiveCurve, EveryPointIsTheExactlyRoundedValueAndEveryChordIsWithinToler
         ASSERT_GT(points[k].position, points[k - 1].position);
       }
       for (int c = 0; c < 3; ++c) {
-        ASSERT_TRUE(IsExactlyRounded(raw[c], points[k].position, curve.finest_level,
-                                     points[k].point[c]))
+        ASSERT_TRUE(
+            IsExactlyRounded(raw[c], points[k].position, curve.finest_level, points[k].point[c]))
             << "trial " << trial << " point " << k << " axis " << c;
       }
     }
@@ -328,9 +330,9 @@ TEST(IsolineWalker, RefusesBadLineCounts) {
   EXPECT_EQ(IsolineWalker<2>::Create(geometry, Basis::kBezier, IsolineFamily::kSLines,
                                      kMaxPatchSteps + 2, &walker),
             Status::kGridOutOfRange);
-  EXPECT_EQ(IsolineWalker<2>::Create(geometry, static_cast<Basis>(9), IsolineFamily::kSLines, 4,
-                                     &walker),
-            Status::kInvalidArgument);
+  EXPECT_EQ(
+      IsolineWalker<2>::Create(geometry, static_cast<Basis>(9), IsolineFamily::kSLines, 4, &walker),
+      Status::kInvalidArgument);
 }
 
 }  // namespace

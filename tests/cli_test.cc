@@ -167,7 +167,8 @@ TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
   ExpectRefused("sample '" + kTeapot + "' --grid 4 --quantum -1", "--quantum: '-1'");
   ExpectRefused("sample '" + kTeapot + "' --grid 4 --engine float", "--engine");
   ExpectRefused("sample '" + kTeapot + "' --grid 4 --frobnicate", "frobnicate");
-  ExpectRefused("bake '" + kTeapot + "'", "unknown command 'bake' (expected sample, check, plot or render)");
+  ExpectRefused("bake '" + kTeapot + "'",
+                "unknown command 'bake' (expected sample, check, plot or render)");
   ExpectRefused("check '" + kTeapot + "' --grid 4 --quantum 0.000000001",
                 "teapot.bpt:2 (patch 0): geometry [0][0].z = 2.4 is out of range");
 
@@ -211,8 +212,9 @@ TEST_F(Cli, PlotRefusesBadOptionsAndLeavesNoFile) {
   refused("--format hpgl --quantum 0.01", "HPGL positions are plotter units");
   ExpectRefused("plot '" + kTeapot + "' -o '" + (dir_ / "missing" / "out.svg").string() + "'",
                 "missing/out.svg.fdsurf-");
-  ExpectRefused("plot '" + kTeapot + "' -o '" + out + "' --png '" + (dir_ / "no" / "t.png").string() + "'",
-                "t.png");
+  ExpectRefused(
+      "plot '" + kTeapot + "' -o '" + out + "' --png '" + (dir_ / "no" / "t.png").string() + "'",
+      "t.png");
   EXPECT_FALSE(fs::exists(out));  // the SVG is not written when the PNG cannot be
   ExpectRefused("render '" + kTeapot + "'", "--output is required");
 }
@@ -225,7 +227,8 @@ TEST_F(Cli, PlotWritesEachFormat) {
     EXPECT_NE(r.err.find("wrote " + out + " (" + format), std::string::npos) << r.err;
     EXPECT_GT(fs::file_size(out), 1000u) << format;
   }
-  const RunResult render = Run("render '" + kTeapot + "' -o '" + (dir_ / "t.png").string() + "' --size 300");
+  const RunResult render =
+      Run("render '" + kTeapot + "' -o '" + (dir_ / "t.png").string() + "' --size 300");
   EXPECT_EQ(render.exit_code, 0) << render.err;
   const std::string png = Slurp(dir_ / "t.png");
   ASSERT_GT(png.size(), 8u);

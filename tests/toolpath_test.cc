@@ -47,13 +47,14 @@ Deviation Measure(const PatchSet& set, const Toolpath& path) {
     std::vector<Vec> points;
     for (const auto& p : s.points) points.push_back({p[0] * q, p[1] * q, p[2] * q});
     for (std::size_t k = 0; k < points.size(); ++k) {
-      worst.points = std::max(worst.points, Distance(points[k], ExactStrokePoint(set, path, s, s.params[k])));
+      worst.points =
+          std::max(worst.points, Distance(points[k], ExactStrokePoint(set, path, s, s.params[k])));
       if (k + 1 == points.size()) break;
       constexpr int kSamples = 16;
       for (int i = 1; i < kSamples; ++i) {
         const double u = s.params[k] + (s.params[k + 1] - s.params[k]) * i / kSamples;
-        worst.chords =
-            std::max(worst.chords, DistanceToSegment(ExactStrokePoint(set, path, s, u), points[k], points[k + 1]));
+        worst.chords = std::max(worst.chords, DistanceToSegment(ExactStrokePoint(set, path, s, u),
+                                                                points[k], points[k + 1]));
       }
     }
   }
@@ -66,7 +67,8 @@ PatchSet RandomPatches(std::mt19937_64& rng) {
   PatchSet set;
   set.units = "mm";
   std::uniform_real_distribution<double> dist(-40, 40);
-  const Basis bases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline, Basis::kCatmullRom};
+  const Basis bases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline,
+                         Basis::kCatmullRom};
   for (Basis basis : bases) {
     Patch patch;
     patch.basis = basis;
@@ -101,9 +103,12 @@ TEST(Toolpath, EveryPointAndChordOfTheTeapotIsWithinTolerance) {
     const char* quantum;
   };
   const Case cases[] = {
-      {"iso", 0.05, 2, StepMode::kAdaptive, "0.001"},  {"top", 0.01, 2, StepMode::kAdaptive, "0.001"},
-      {"30,60", 0.2, 3, StepMode::kAdaptive, "0.001"}, {"front", 0.05, 2, StepMode::kFixed, "0.001"},
-      {"side", 0.05, 3, StepMode::kFixed, "0.001"},    {"iso", 0.04, 2, StepMode::kAdaptive, "0.025"},
+      {"iso", 0.05, 2, StepMode::kAdaptive, "0.001"},
+      {"top", 0.01, 2, StepMode::kAdaptive, "0.001"},
+      {"30,60", 0.2, 3, StepMode::kAdaptive, "0.001"},
+      {"front", 0.05, 2, StepMode::kFixed, "0.001"},
+      {"side", 0.05, 3, StepMode::kFixed, "0.001"},
+      {"iso", 0.04, 2, StepMode::kAdaptive, "0.025"},
       {"iso", 0.02, 2, StepMode::kStepExact, "0.01"},
   };
   for (const Case& c : cases) {
@@ -125,8 +130,8 @@ TEST(Toolpath, RandomPatchesOfEveryBasisStayWithinTolerance) {
     const PatchSet set = RandomPatches(rng);
     for (StepMode mode : {StepMode::kAdaptive, StepMode::kFixed}) {
       const double tolerance = trial % 2 == 0 ? 0.01 : 0.3;
-      const Toolpath path = BuildToolpath(set, Options(trial % 3 == 0 ? "iso" : "-20,10", tolerance,
-                                                       2 + trial % 2, mode), "mm");
+      const Toolpath path = BuildToolpath(
+          set, Options(trial % 3 == 0 ? "iso" : "-20,10", tolerance, 2 + trial % 2, mode), "mm");
       const Deviation d = Measure(set, path);
       EXPECT_LE(d.points, tolerance) << trial;
       EXPECT_LE(d.chords, tolerance) << trial;

@@ -43,12 +43,13 @@ bool GeometryInRange(int64_t v) { return v < kGeometryLimitRaw && v > -kGeometry
 // round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
 // floor((2|x| + ab) / 2ab) by successive floor divisions, which compose.
 int64_t RoundedQuotient(const internal::WideInt<4>& x, uint32_t a, uint32_t b) {
-  internal::WideInt<4> y = x.Abs().ShiftedLeft(1) +
-                           internal::WideInt<4>::FromUint64(static_cast<uint64_t>(a) * b);
+  internal::WideInt<4> y =
+      x.Abs().ShiftedLeft(1) + internal::WideInt<4>::FromUint64(static_cast<uint64_t>(a) * b);
   y.ShiftRightInPlace(1);
   y.DivideInPlace(a);
   y.DivideInPlace(b);
-  const uint64_t magnitude = static_cast<uint64_t>(y.limb(0)) | (static_cast<uint64_t>(y.limb(1)) << 32);
+  const uint64_t magnitude =
+      static_cast<uint64_t>(y.limb(0)) | (static_cast<uint64_t>(y.limb(1)) << 32);
   const int64_t value = static_cast<int64_t>(magnitude);
   return x.IsNegative() ? -value : value;
 }
@@ -59,8 +60,9 @@ template <int kDims>
 Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
                             PreparedAdaptiveCurve<kDims>* out) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
-  const int64_t budget16 = static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
-                           (int64_t{1} << 15) - kPreStepAllowance16;
+  const int64_t budget16 =
+      static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
+      (int64_t{1} << 15) - kPreStepAllowance16;
   if (budget16 <= 0) return Status::kToleranceUnreachable;
   const bool step_exact = settings.mode == AdaptiveMode::kStepExact;
 
@@ -87,7 +89,8 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   for (;; ++level) {
     if (level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
     bool fits = true;
-    const Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
+    const Wide chord_limit =
+        Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
     for (int c = 0; c < kDims && fits; ++c) {
       const Wide second = Wide::FromUint64(6 * m[c][0] + 2 * m[c][1]).ShiftedLeft(level) +
                           Wide::FromUint64(6 * m[c][0]);
@@ -106,9 +109,9 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   // 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F.
   Wide largest;
   for (int c = 0; c < kDims; ++c) {
-    const Wide bound =
-        Wide::FromUint64(8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3])).ShiftedLeft(3 * level) +
-        Wide::PowerOfTwo(frac_bits);
+    const Wide bound = Wide::FromUint64(8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3]))
+                           .ShiftedLeft(3 * level) +
+                       Wide::PowerOfTwo(frac_bits);
     if (largest < bound) largest = bound;
   }
   int acc_bits = 0;
@@ -161,8 +164,8 @@ Status CurvePowerCoefficients(const CurveGeometry1 (&geometry)[kDims], Basis bas
     for (int k = 0; k < 4; ++k) {
       int64_t scaled = 0;  // |scaled| < 12·2^47
       for (int i = 0; i < 4; ++i) scaled += m->matrix[k][i] * geometry[c].g[i].Raw();
-      result[c].c[k] =
-          RoundedQuotient(internal::WideInt<4>::FromInt64(scaled), static_cast<uint32_t>(m->denominator), 1);
+      result[c].c[k] = RoundedQuotient(internal::WideInt<4>::FromInt64(scaled),
+                                       static_cast<uint32_t>(m->denominator), 1);
     }
   }
   for (int c = 0; c < kDims; ++c) out[c] = result[c];
@@ -179,11 +182,11 @@ Status IsolineWalker<kDims>::Create(const PatchGeometry1 (&geometry)[kDims], Bas
   // E' = n³·E(1/n), the integer form of the difference operator across the patch.
   const int64_t e[4][4] = {{0, 0, 0, n * n * n}, {1, n, n * n, 0}, {6, 2 * n, 0, 0}, {6, 0, 0, 0}};
   IsolineWalker walker;
-  for (int c = 0; c < kDims; ++c) {
-    const PatchGeometry1& g = geometry[c];
-    for (int i = 0; i < 4; ++i) {
-      for (int j = 0; j < 4; ++j) {
-        if (!GeometryInRange(g.g[i][j].Raw())) return Status::kGeometryOutOfRange;
+  int c = 0;
+  for (const PatchGeometry1& g : geometry) {
+    for (const auto& row : g.g) {
+      for (const GeometryFixed& value : row) {
+        if (!GeometryInRange(value.Raw())) return Status::kGeometryOutOfRange;
       }
     }
     // d²·2^16·C = (dM)·G·(dM)ᵀ, below 12·12·2^47 < 2^55 in magnitude.
@@ -218,6 +221,7 @@ Status IsolineWalker<kDims>::Create(const PatchGeometry1 (&geometry)[kDims], Bas
         walker.table_[c][r][l] = ToInt128(wide);
       }
     }
+    ++c;
   }
   walker.divisor_[0] = static_cast<uint32_t>(m->denominator * m->denominator);
   walker.divisor_[1] = static_cast<uint32_t>(n * n * n);

@@ -76,7 +76,9 @@ std::array<Point3, 4> LineCoefficients(const PowerCoefficients& pc, IsolineFamil
   return line;
 }
 
-double LineParam(int i, int lines) { return lines == 1 ? 0.0 : static_cast<double>(i) / (lines - 1); }
+double LineParam(int i, int lines) {
+  return lines == 1 ? 0.0 : static_cast<double>(i) / (lines - 1);
+}
 
 struct Box {
   std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL};
@@ -137,13 +139,14 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
   const double limit = std::ldexp(1.0, 31);
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
-      const auto out = IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
+      const auto out =
+          IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
       for (int c = 0; c < kDims; ++c) {
         const double q = quantum.ToQuanta(out[c]);
         if (!(std::fabs(q) < limit)) {
-          throw EngineError(patch.origin + ": in output space a control value reaches " + Number(out[c]) +
-                            " " + "units, beyond ±2^31 quanta of " + quantum.Format(1) +
-                            "; use a coarser quantum or a smaller --fit");
+          throw EngineError(patch.origin + ": in output space a control value reaches " +
+                            Number(out[c]) + " " + "units, beyond ±2^31 quanta of " +
+                            quantum.Format(1) + "; use a coarser quantum or a smaller --fit");
         }
         geometry[c].g[i][j] = GeometryFixed::FromRaw(
             static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
@@ -152,8 +155,10 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
   }
   const double tolerance_q = options.tolerance / quantum.value();
   AdaptiveSettings settings;
-  settings.mode = options.mode == StepMode::kStepExact ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
-  settings.tolerance_q8 = static_cast<std::uint32_t>(std::min(std::floor(tolerance_q * 256), 4294967295.0));
+  settings.mode =
+      options.mode == StepMode::kStepExact ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
+  settings.tolerance_q8 =
+      static_cast<std::uint32_t>(std::min(std::floor(tolerance_q * 256), 4294967295.0));
 
   const auto refuse = [&](Status status, const std::string& line) {
     std::string why = patch.origin + ": " + line + ": ";
@@ -176,8 +181,8 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
   const auto draw_family = [&](IsolineFamily family, int lines) {
     if (lines == 0) return;
     IsolineWalker<kDims> walker;
-    const Status created =
-        IsolineWalker<kDims>::Create(geometry, patch.basis, family, static_cast<std::uint16_t>(lines), &walker);
+    const Status created = IsolineWalker<kDims>::Create(geometry, patch.basis, family,
+                                                        static_cast<std::uint16_t>(lines), &walker);
     if (created != Status::kOk) refuse(created, "isolines");
     PowerCurve1 curve[kDims];
     for (int i = 0; walker.Next(curve); ++i) {
@@ -187,7 +192,7 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
       stroke.line_param = LineParam(i, lines);
       const std::string name =
           std::string(family == IsolineFamily::kSLines ? "s" : "t") + "-line " + std::to_string(i);
-      const auto add = [&](double param, const std::int32_t (&p)[kDims]) {
+      const auto add = [&](double param, const std::int32_t(&p)[kDims]) {
         std::array<std::int64_t, 3> point{0, 0, 0};
         for (int c = 0; c < kDims; ++c) point[c] = p[c];
         // A repeated point draws nothing; the chord to the next point covers
@@ -197,7 +202,8 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
         stroke.params.push_back(param);
       };
       if (options.mode == StepMode::kFixed) {
-        // The fewest uniform steps N with √d/8·max|x''|/N² + √d·0.511 ≤ tolerance (0.51 stepping, 2^-12 geometry and coefficient rounding).
+        // The fewest uniform steps N with √d/8·max|x''|/N² + √d·0.511 ≤ tolerance (0.51 stepping,
+        // 2^-12 geometry and coefficient rounding).
         double second = 0;
         for (int c = 0; c < kDims; ++c) {
           second = std::max(second, (6 * std::fabs(static_cast<double>(curve[c].c[0])) +
@@ -212,10 +218,10 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
           for (int k = 0; k < 4; ++k) power[c].g[k] = GeometryFixed::FromRaw(curve[c].c[k]);
         }
         PreparedCurve<kDims> prepared;
-        const Status status =
-            PrepareCurve(power, Basis::kPower, static_cast<std::uint16_t>(n), PrepareOptions{}, &prepared);
+        const Status status = PrepareCurve(power, Basis::kPower, static_cast<std::uint16_t>(n),
+                                           PrepareOptions{}, &prepared);
         if (status != Status::kOk) refuse(status, name);
-        const auto sink = [&](std::uint32_t k, const std::int32_t (&p)[kDims]) { add(k / n, p); };
+        const auto sink = [&](std::uint32_t k, const std::int32_t(&p)[kDims]) { add(k / n, p); };
         if (prepared.format.acc_bits == 64) {
           CurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
         } else {
@@ -226,7 +232,7 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
         const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
         if (status != Status::kOk) refuse(status, name);
         const double unit = std::ldexp(1.0, -prepared.finest_level);
-        const auto sink = [&](std::uint32_t position, const std::int32_t (&p)[kDims]) {
+        const auto sink = [&](std::uint32_t position, const std::int32_t(&p)[kDims]) {
           add(position * unit, p);
         };
         if (prepared.format.acc_bits == 64) {
@@ -249,7 +255,8 @@ double PlaneDistance(const std::array<std::int64_t, 3>& a, const std::array<std:
 
 double StrokeLength(const Stroke& s) {
   double length = 0;
-  for (std::size_t k = 1; k < s.points.size(); ++k) length += PlaneDistance(s.points[k - 1], s.points[k]);
+  for (std::size_t k = 1; k < s.points.size(); ++k)
+    length += PlaneDistance(s.points[k - 1], s.points[k]);
   return length;
 }
 
@@ -322,8 +329,8 @@ std::array<double, 3> OutputMap::Apply(const Point3& p) const {
   return out;
 }
 
-Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, const std::string& units,
-                       const Progress& progress) {
+Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
+                       const std::string& units, const Progress& progress) {
   if (options.lines_s == 1 || options.lines_t == 1 || options.lines_s < 0 || options.lines_t < 0 ||
       options.lines_s > kMaxPatchSteps + 1 || options.lines_t > kMaxPatchSteps + 1) {
     throw InputError("--lines: each count must be 0 (family left out) or 2.." +
@@ -332,13 +339,14 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, cons
   if (options.lines_s == 0 && options.lines_t == 0) {
     throw InputError("--lines: both families are left out; nothing to draw");
   }
-  const double needed = std::sqrt(static_cast<double>(options.dims)) * (0.5 + 1.0 / 1024) *
-                        options.quantum.value();
+  const double needed =
+      std::sqrt(static_cast<double>(options.dims)) * (0.5 + 1.0 / 1024) * options.quantum.value();
   if (!(options.tolerance > needed * 1.003)) {
     throw InputError("--tolerance " + Number(options.tolerance) + " " + units +
                      " is too small: with points rounded to the quantum " +
-                     options.quantum.Format(1) + " " + units + " it must exceed " + Number(needed * 1.003) +
-                     " " + units + " (√" + std::to_string(options.dims) + "·0.501 quanta)");
+                     options.quantum.Format(1) + " " + units + " it must exceed " +
+                     Number(needed * 1.003) + " " + units + " (√" + std::to_string(options.dims) +
+                     "·0.501 quanta)");
   }
   if (set.patches.empty()) throw InputError("the file has no patches to draw");
 
@@ -356,8 +364,9 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, cons
     const double w = (*options.fit)[0] - 2 * options.margin;
     const double h = (*options.fit)[1] - 2 * options.margin;
     if (!(w > 0 && h > 0)) {
-      throw InputError("--fit: the page " + Number((*options.fit)[0]) + "x" + Number((*options.fit)[1]) +
-                       " leaves no room inside the margin of " + Number(options.margin));
+      throw InputError("--fit: the page " + Number((*options.fit)[0]) + "x" +
+                       Number((*options.fit)[1]) + " leaves no room inside the margin of " +
+                       Number(options.margin));
     }
     if (bw <= 0 && bh <= 0) throw InputError("--fit: the drawing is a single point in this view");
     scale = std::min(bw > 0 ? w / bw : HUGE_VAL, bh > 0 ? h / bh : HUGE_VAL);
@@ -387,8 +396,8 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, cons
   return path;
 }
 
-std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path, const Stroke& stroke,
-                                       double param) {
+std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
+                                       const Stroke& stroke, double param) {
   const Patch& patch = set.patches[stroke.patch];
   const Point3 p = stroke.family == IsolineFamily::kSLines
                        ? EvaluateReference(patch, stroke.line_param, param)
@@ -496,10 +505,14 @@ PlanReport PlanStrokes(Toolpath* path) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto before = exit_of(i);
       for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
-        const double old_links = PlaneDistance(before, ordered[i].points.front()) +
-                                 (j + 1 < n ? PlaneDistance(ordered[j].points.back(), ordered[j + 1].points.front()) : 0);
-        const double new_links = PlaneDistance(before, ordered[j].points.back()) +
-                                 (j + 1 < n ? PlaneDistance(ordered[i].points.front(), ordered[j + 1].points.front()) : 0);
+        const double old_links =
+            PlaneDistance(before, ordered[i].points.front()) +
+            (j + 1 < n ? PlaneDistance(ordered[j].points.back(), ordered[j + 1].points.front())
+                       : 0);
+        const double new_links =
+            PlaneDistance(before, ordered[j].points.back()) +
+            (j + 1 < n ? PlaneDistance(ordered[i].points.front(), ordered[j + 1].points.front())
+                       : 0);
         if (new_links < old_links - 1e-9) {
           std::reverse(ordered.begin() + static_cast<std::ptrdiff_t>(i),
                        ordered.begin() + static_cast<std::ptrdiff_t>(j) + 1);

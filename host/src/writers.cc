@@ -55,17 +55,20 @@ std::string WriteSvg(const Toolpath& path, const std::string& title) {
   const std::string height = q.Format(h);
   const double pen = path.units == "in" ? 0.01 : 0.25;
   std::ostringstream out;
-  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << width << path.units
-      << "\" height=\"" << height << path.units << "\" viewBox=\"0 0 " << width << " " << height
+  out << R"(<?xml version="1.0" encoding="UTF-8"?>)"
+      << "\n"
+      << R"(<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width=")" << width << path.units
+      << R"(" height=")" << height << path.units << R"(" viewBox="0 0 )" << width << " " << height
       << "\">\n"
       << "<title>" << XmlEscaped(title) << "</title>\n"
-      << "<g fill=\"none\" stroke=\"black\" stroke-width=\"" << Trimmed(pen)
-      << "\" stroke-linecap=\"round\" stroke-linejoin=\"round\">\n";
+      << R"(<g fill="none" stroke="black" stroke-width=")" << Trimmed(pen)
+      << R"(" stroke-linecap="round" stroke-linejoin="round">)"
+      << "\n";
   for (const Stroke& s : path.strokes) {
     out << "<path d=\"";
     for (std::size_t k = 0; k < s.points.size(); ++k) {
-      out << (k == 0 ? "M" : " L") << q.Format(s.points[k][0]) << " " << q.Format(h - s.points[k][1]);
+      out << (k == 0 ? "M" : " L") << q.Format(s.points[k][0]) << " "
+          << q.Format(h - s.points[k][1]);
     }
     out << "\"/>\n";
   }
@@ -153,14 +156,15 @@ std::string WriteStrokesJson(const Toolpath& path) {
     if (path.dims == 3) out << "," << q.Format(p[2]);
     out << "]";
   };
-  out << "{\"units\":\"" << path.units << "\",\"quantum\":" << q.Format(1) << ",\"dims\":" << path.dims
-      << ",\"width\":" << q.Format(PageQuanta(path.width, q))
+  out << R"({"units":")" << path.units << R"(","quantum":)" << q.Format(1)
+      << ",\"dims\":" << path.dims << ",\"width\":" << q.Format(PageQuanta(path.width, q))
       << ",\"height\":" << q.Format(PageQuanta(path.height, q)) << ",\"bbox\":[";
   if (path.dims == 3) {
-    out << q.Format(lo[0]) << "," << q.Format(lo[1]) << "," << q.Format(lo[2]) << "," << q.Format(hi[0])
-        << "," << q.Format(hi[1]) << "," << q.Format(hi[2]);
+    out << q.Format(lo[0]) << "," << q.Format(lo[1]) << "," << q.Format(lo[2]) << ","
+        << q.Format(hi[0]) << "," << q.Format(hi[1]) << "," << q.Format(hi[2]);
   } else {
-    out << q.Format(lo[0]) << "," << q.Format(lo[1]) << "," << q.Format(hi[0]) << "," << q.Format(hi[1]);
+    out << q.Format(lo[0]) << "," << q.Format(lo[1]) << "," << q.Format(hi[0]) << ","
+        << q.Format(hi[1]);
   }
   out << "],\"strokes\":[";
   for (std::size_t i = 0; i < path.strokes.size(); ++i) {

@@ -4,12 +4,12 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <charconv>
 #include <cerrno>
-#include <cstdlib>
-#include <cstring>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -169,7 +169,6 @@ int RunCheck(const SampleOptions& options) {
   return worst <= 0.51 ? 0 : 1;
 }
 
-
 std::string Number(double v) {
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", v);
@@ -208,7 +207,8 @@ double ParsePositive(const std::string& text, const std::string& what, bool allo
     throw InputError(what + ": '" + text + "' is not a number");
   }
   if (value < 0 || (value == 0 && !allow_zero)) {
-    throw InputError(what + ": '" + text + "' must be " + (allow_zero ? "zero or more" : "greater than zero"));
+    throw InputError(what + ": '" + text + "' must be " +
+                     (allow_zero ? "zero or more" : "greater than zero"));
   }
   return value;
 }
@@ -220,7 +220,8 @@ std::array<int, 2> ParseLines(const std::string& text) {
     const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
     if (part.empty() || ec != std::errc() || end != part.data() + part.size() || value == 1 ||
         value < 0 || value > kMaxPatchSteps + 1) {
-      throw InputError("--lines: '" + text + "' is not U or UxV with each count 0 (left out) or 2.." +
+      throw InputError("--lines: '" + text +
+                       "' is not U or UxV with each count 0 (left out) or 2.." +
                        std::to_string(kMaxPatchSteps + 1));
     }
     return value;
@@ -233,7 +234,8 @@ std::array<int, 2> ParseLines(const std::string& text) {
 std::array<double, 2> ParsePage(const std::string& text) {
   const std::size_t x = text.find('x');
   if (x == std::string::npos) throw InputError("--fit: '" + text + "' is not WxH (like 200x150)");
-  return {ParsePositive(text.substr(0, x), "--fit width"), ParsePositive(text.substr(x + 1), "--fit height")};
+  return {ParsePositive(text.substr(0, x), "--fit width"),
+          ParsePositive(text.substr(x + 1), "--fit height")};
 }
 
 std::string FormatFromName(const std::string& name) {
@@ -275,10 +277,13 @@ class StagedOutputs {
   std::vector<std::pair<std::string, std::string>> staged_;
 };
 
-bool ShowProgress(bool quiet) { return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr; }
+bool ShowProgress(bool quiet) {
+  return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr;
+}
 
 int RunPlot(const PlotOptions& o, bool render_only) {
-  const std::string format = render_only ? "png" : (o.format.empty() ? FormatFromName(o.output) : o.format);
+  const std::string format =
+      render_only ? "png" : (o.format.empty() ? FormatFromName(o.output) : o.format);
   const bool hpgl = format == "hpgl";
   // Option values are in --units; HPGL files are always in plotter units of
   // 0.025 mm, so an HPGL job works in mm internally.
@@ -286,7 +291,7 @@ int RunPlot(const PlotOptions& o, bool render_only) {
   const std::string work_units = hpgl ? "mm" : o.units;
   ToolpathOptions t;
   t.tolerance = to_work * (o.tolerance.empty() ? (o.units == "in" ? 0.002 : 0.05)
-                                                : ParsePositive(o.tolerance, "--tolerance"));
+                                               : ParsePositive(o.tolerance, "--tolerance"));
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
   t.lines_t = lines[1];
@@ -295,31 +300,38 @@ int RunPlot(const PlotOptions& o, bool render_only) {
     auto page = ParsePage(o.fit);
     t.fit = std::array<double, 2>{page[0] * to_work, page[1] * to_work};
   }
-  t.margin = to_work * (o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0) : ParsePositive(o.margin, "--margin", true));
+  t.margin = to_work * (o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0)
+                                         : ParsePositive(o.margin, "--margin", true));
   if (hpgl) {
     if (!o.quantum.empty() && o.quantum != "0.025") {
-      throw InputError("--quantum: HPGL positions are plotter units of 0.025 mm; leave --quantum out");
+      throw InputError(
+          "--quantum: HPGL positions are plotter units of 0.025 mm; leave --quantum out");
     }
     t.quantum = Quantum::Parse("0.025");
   } else {
-    t.quantum = Quantum::Parse(o.quantum.empty() ? (o.units == "in" ? "0.0001" : "0.001") : o.quantum);
+    t.quantum =
+        Quantum::Parse(o.quantum.empty() ? (o.units == "in" ? "0.0001" : "0.001") : o.quantum);
   }
   if (o.dims == 3 && format != "gcode" && format != "json") {
     throw InputError("--dims 3: only G-code and JSON carry a third axis");
   }
   t.dims = o.dims;
-  t.mode = o.mode == "fixed" ? StepMode::kFixed : o.mode == "step-exact" ? StepMode::kStepExact : StepMode::kAdaptive;
+  t.mode = o.mode == "fixed"        ? StepMode::kFixed
+           : o.mode == "step-exact" ? StepMode::kStepExact
+                                    : StepMode::kAdaptive;
 
   const PatchSet set = ReadPatchFile(o.file);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
 
   const bool progress = ShowProgress(o.quiet);
-  Toolpath path = BuildToolpath(set, t, work_units, [&](std::size_t done, std::size_t all, std::size_t points) {
-    if (progress) {
-      std::fprintf(stderr, "\rfdsurf: patch %zu/%zu (%3zu%%), %zu points", done, all, done * 100 / all, points);
-    }
-  });
+  Toolpath path =
+      BuildToolpath(set, t, work_units, [&](std::size_t done, std::size_t all, std::size_t points) {
+        if (progress) {
+          std::fprintf(stderr, "\rfdsurf: patch %zu/%zu (%3zu%%), %zu points", done, all,
+                       done * 100 / all, points);
+        }
+      });
   if (progress) std::fputc('\n', stderr);
   std::size_t points = 0;
   std::size_t longest = 0;
@@ -334,9 +346,9 @@ int RunPlot(const PlotOptions& o, bool render_only) {
   std::vector<std::string> header = {
       "generated by fdsurf plot (fixed-point forward differences)",
       "source: " + o.file + " (" + std::to_string(set.patches.size()) + " patches)",
-      "view " + t.view.name + ", lines " + std::to_string(t.lines_s) + "x" + std::to_string(t.lines_t) +
-          ", mode " + o.mode + ", tolerance " + Number(t.tolerance) + " " + work_units + ", quantum " +
-          t.quantum.Format(1) + " " + work_units,
+      "view " + t.view.name + ", lines " + std::to_string(t.lines_s) + "x" +
+          std::to_string(t.lines_t) + ", mode " + o.mode + ", tolerance " + Number(t.tolerance) +
+          " " + work_units + ", quantum " + t.quantum.Format(1) + " " + work_units,
       "page " + Number(path.width) + " x " + Number(path.height) + " " + work_units + ", " +
           std::to_string(path.strokes.size()) + " strokes, " + std::to_string(points) + " points"};
 
@@ -360,62 +372,82 @@ int RunPlot(const PlotOptions& o, bool render_only) {
     outputs.Commit();
   }
   if (!o.quiet) {
-    std::fprintf(stderr, "%s: %zu patches, %zu curves, %zu points, longest curve %zu (%s, tolerance %s %s)\n",
-                 o.file.c_str(), set.patches.size(), curves, points, longest, o.mode.c_str(),
-                 Number(t.tolerance).c_str(), work_units.c_str());
+    std::fprintf(
+        stderr,
+        "%s: %zu patches, %zu curves, %zu points, longest curve %zu (%s, tolerance %s %s)\n",
+        o.file.c_str(), set.patches.size(), curves, points, longest, o.mode.c_str(),
+        Number(t.tolerance).c_str(), work_units.c_str());
     if (o.plan) {
       std::fprintf(stderr,
                    "plan: %zu strokes -> %zu (%zu drawn twice removed); pen-down %.1f -> %.1f %s; "
                    "pen-up %.1f -> %.1f %s\n",
-                   plan.strokes_before, plan.strokes_after, plan.duplicates_removed, plan.pen_down_before,
-                   plan.pen_down_after, work_units.c_str(), plan.pen_up_before, plan.pen_up_after,
-                   work_units.c_str());
+                   plan.strokes_before, plan.strokes_after, plan.duplicates_removed,
+                   plan.pen_down_before, plan.pen_down_after, work_units.c_str(),
+                   plan.pen_up_before, plan.pen_up_after, work_units.c_str());
     }
     if (!render_only && o.output != "-") {
       std::fprintf(stderr, "wrote %s (%s, page %s x %s %s)\n", o.output.c_str(), format.c_str(),
                    Number(path.width).c_str(), Number(path.height).c_str(), work_units.c_str());
     }
-    if (!png.empty()) std::fprintf(stderr, "wrote %s (png, %d px wide)\n", png.c_str(), o.png_width);
+    if (!png.empty())
+      std::fprintf(stderr, "wrote %s (png, %d px wide)\n", png.c_str(), o.png_width);
   }
   return 0;
 }
 
 void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
-  command->add_option("FILE", o->file, "patch file (.bpt or .json, see docs/formats.md)")->required();
+  command->add_option("FILE", o->file, "patch file (.bpt or .json, see docs/formats.md)")
+      ->required();
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();
   } else {
-    command->add_option("--format", o->format, "svg, gcode, hpgl or json (default: from -o's extension, else svg)")
+    command
+        ->add_option("--format", o->format,
+                     "svg, gcode, hpgl or json (default: from -o's extension, else svg)")
         ->check(CLI::IsMember({"svg", "gcode", "hpgl", "json"}));
-    command->add_option("-o,--output", o->output, "output file, - for stdout")->capture_default_str();
+    command->add_option("-o,--output", o->output, "output file, - for stdout")
+        ->capture_default_str();
     command->add_option("--png", o->png, "also draw the result as a PNG picture");
   }
-  command->add_option("--size", o->png_width, "PNG width in pixels")->check(CLI::Range(16, 20000))->capture_default_str();
-  command->add_option("--tolerance", o->tolerance,
-                      "largest distance of the drawing from the exact curves, in --units (default 0.05 mm / "
-                      "0.002 in)");
-  command->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
+  command->add_option("--size", o->png_width, "PNG width in pixels")
+      ->check(CLI::Range(16, 20000))
       ->capture_default_str();
-  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")->capture_default_str();
+  command->add_option(
+      "--tolerance", o->tolerance,
+      "largest distance of the drawing from the exact curves, in --units (default 0.05 mm / "
+      "0.002 in)");
+  command
+      ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
+      ->capture_default_str();
+  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")
+      ->capture_default_str();
   command->add_option("--units", o->units, "units of the output and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
   command->add_option("--fit", o->fit, "scale the drawing to fit a WxH page");
   command->add_option("--margin", o->margin, "space around the drawing (default 5 mm / 0.2 in)");
-  command->add_option("--quantum", o->quantum, "output resolution (default 0.001 mm / 0.0001 in; HPGL 0.025 mm)");
-  command->add_option("--mode", o->mode, "adaptive, fixed (uniform steps) or step-exact (≤ 1 quantum per axis)")
+  command->add_option("--quantum", o->quantum,
+                      "output resolution (default 0.001 mm / 0.0001 in; HPGL 0.025 mm)");
+  command
+      ->add_option("--mode", o->mode,
+                   "adaptive, fixed (uniform steps) or step-exact (≤ 1 quantum per axis)")
       ->check(CLI::IsMember({"adaptive", "fixed", "step-exact"}))
       ->capture_default_str();
   if (!render_only) {
     command->add_option("--dims", o->dims, "2 (the view plane) or 3 (with depth, for CNC G-code)")
         ->check(CLI::IsMember({2, 3}))
         ->capture_default_str();
-    command->add_option("--pen", o->gcode.pen, "G-code pen control: z (Z moves) or m3 (M3/M5 and a dwell)")
+    command
+        ->add_option("--pen", o->gcode.pen,
+                     "G-code pen control: z (Z moves) or m3 (M3/M5 and a dwell)")
         ->check(CLI::IsMember({"z", "m3"}))
         ->capture_default_str();
-    command->add_option("--pen-up", o->gcode.pen_up_z, "G-code Z with the pen up (also 3-D travel height)")
+    command
+        ->add_option("--pen-up", o->gcode.pen_up_z,
+                     "G-code Z with the pen up (also 3-D travel height)")
         ->capture_default_str();
-    command->add_option("--pen-down", o->gcode.pen_down_z, "G-code Z with the pen down")->capture_default_str();
+    command->add_option("--pen-down", o->gcode.pen_down_z, "G-code Z with the pen down")
+        ->capture_default_str();
     command->add_option("--feed", o->gcode.feed, "G-code drawing feed, units per minute")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
@@ -425,7 +457,8 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
     command->add_option("--dwell", o->gcode.dwell, "G-code dwell after M3/M5, seconds")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
-    command->add_flag("!--no-plan", o->plan, "keep the curves as drawn, without joining or ordering");
+    command->add_flag("!--no-plan", o->plan,
+                      "keep the curves as drawn, without joining or ordering");
   }
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
@@ -467,7 +500,8 @@ int Main(int argc, char** argv) {
 
   PlotOptions plot_options;
   CLI::App* plot = app.add_subcommand(
-      "plot", "Draw the patches as a wireframe of isolines for a plotter or CNC: SVG, G-code, HPGL.");
+      "plot",
+      "Draw the patches as a wireframe of isolines for a plotter or CNC: SVG, G-code, HPGL.");
   AddPlotOptions(plot, &plot_options, false);
   PlotOptions render_options;
   CLI::App* render = app.add_subcommand("render", "Draw the patches' isolines as a PNG picture.");

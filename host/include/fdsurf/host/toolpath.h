@@ -74,7 +74,7 @@ struct OutputMap {
   double scale = 1.0;
   std::array<double, 3> offset{};
   std::array<double, 3> Apply(const Point3& p) const;
-  std::array<double, 3> ApplyLinear(const Point3& v) const;
+  std::array<double, 3> ApplyLinear(const Point3& p) const;
 };
 
 /// One drawn curve: whole-quantum points (z = 0 when dims = 2) and where
@@ -106,13 +106,13 @@ using Progress = std::function<void(std::size_t, std::size_t, std::size_t)>;
 /// Draws every patch's isolines. Throws InputError for options that cannot
 /// be met (tolerance below the quantum's reach, a drawing that does not fit)
 /// and EngineError (fixed_engine.h) when the engine refuses a curve.
-Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options, const std::string& units,
-                       const Progress& progress = {});
+Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
+                       const std::string& units, const Progress& progress = {});
 
 /// The exact point of an isoline in output units (the double reference,
 /// through the same map), for checks.
-std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path, const Stroke& stroke,
-                                       double param);
+std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
+                                       const Stroke& stroke, double param);
 
 struct PlanReport {
   std::size_t strokes_before = 0;
