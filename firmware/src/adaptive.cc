@@ -22,22 +22,6 @@ uint64_t Magnitude(int64_t v) {
   return v < 0 ? ~static_cast<uint64_t>(v) + 1 : static_cast<uint64_t>(v);
 }
 
-Int128 ToInt128(const Wide& w) {
-  Int128 v;
-  v.lo = static_cast<uint64_t>(w.limb(0)) | (static_cast<uint64_t>(w.limb(1)) << 32);
-  v.hi = static_cast<uint64_t>(w.limb(2)) | (static_cast<uint64_t>(w.limb(3)) << 32);
-  return v;
-}
-
-internal::WideInt<4> FromInt128(const Int128& v) {
-  internal::WideInt<4> w;
-  w.set_limb(0, static_cast<uint32_t>(v.lo));
-  w.set_limb(1, static_cast<uint32_t>(v.lo >> 32));
-  w.set_limb(2, static_cast<uint32_t>(v.hi));
-  w.set_limb(3, static_cast<uint32_t>(v.hi >> 32));
-  return w;
-}
-
 bool GeometryInRange(int64_t v) { return v < kGeometryLimitRaw && v > -kGeometryLimitRaw; }
 
 // round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
@@ -135,18 +119,18 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
     const Wide d = Wide::FromInt64(curve[c].c[3]);
     // Step h = 2^-L in units of 2^-(16+3L): Δ⁰ = d·2^3L, Δ¹ = a + b·2^L + c·2^2L,
     // Δ² = 6a + 2b·2^L, Δ³ = 6a.
-    result.d[c][0] = ToInt128(d.ShiftedLeft(3 * level));
-    result.d[c][1] = ToInt128(a + b.ShiftedLeft(level) + cc.ShiftedLeft(2 * level));
-    result.d[c][2] = ToInt128(a.MulInt64(6) + b.ShiftedLeft(level + 1));
-    result.d[c][3] = ToInt128(a.MulInt64(6));
+    result.d[c][0] = internal::ToInt128(d.ShiftedLeft(3 * level));
+    result.d[c][1] = internal::ToInt128(a + b.ShiftedLeft(level) + cc.ShiftedLeft(2 * level));
+    result.d[c][2] = internal::ToInt128(a.MulInt64(6) + b.ShiftedLeft(level + 1));
+    result.d[c][3] = internal::ToInt128(a.MulInt64(6));
   }
   // Values never exceed `largest`, so a larger limit would act the same;
   // clamping keeps it representable in the accumulator.
   Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
   const Wide clamp = Wide::PowerOfTwo(acc_bits - 2);
   if (clamp < chord_limit) chord_limit = clamp;
-  result.chord_limit = ToInt128(chord_limit);
-  result.step_limit = ToInt128(Wide::PowerOfTwo(frac_bits));
+  result.chord_limit = internal::ToInt128(chord_limit);
+  result.step_limit = internal::ToInt128(Wide::PowerOfTwo(frac_bits));
   *out = result;
   return Status::kOk;
 }
@@ -217,8 +201,7 @@ Status IsolineWalker<kDims>::Create(const PatchGeometry1 (&geometry)[kDims], Bas
         for (int k = 0; k < 4; ++k) {
           if (e[r][k] != 0) sum += internal::WideInt<4>::FromInt64(power[k][l]).MulInt64(e[r][k]);
         }
-        const Wide wide = sum.Resized<8>();
-        walker.table_[c][r][l] = ToInt128(wide);
+        walker.table_[c][r][l] = internal::ToInt128(sum);
       }
     }
     ++c;
@@ -236,7 +219,8 @@ bool IsolineWalker<kDims>::Next(PowerCurve1 (&curve)[kDims]) {
   if (produced_ >= lines_) return false;
   for (int c = 0; c < kDims; ++c) {
     for (int l = 0; l < 4; ++l) {
-      curve[c].c[l] = RoundedQuotient(FromInt128(table_[c][0][l]), divisor_[0], divisor_[1]);
+      curve[c].c[l] =
+          RoundedQuotient(internal::FromInt128(table_[c][0][l]), divisor_[0], divisor_[1]);
     }
   }
   ++produced_;

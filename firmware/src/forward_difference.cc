@@ -184,13 +184,6 @@ Wide RoundedQuotient(const Narrow& x, int frac_bits, const Denominator& d, bool*
   return x.IsNegative() ? -y : y;
 }
 
-Int128 ToInt128(const Wide& w) {
-  Int128 v;
-  v.lo = static_cast<uint64_t>(w.limb(0)) | (static_cast<uint64_t>(w.limb(1)) << 32);
-  v.hi = static_cast<uint64_t>(w.limb(2)) | (static_cast<uint64_t>(w.limb(3)) << 32);
-  return v;
-}
-
 // The table of one coordinate and the bounds on its differences.
 struct Plane {
   Narrow dd[4][4];   // scaled exact table
@@ -297,7 +290,7 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
         // Implied by FitsWidth; kept so that a planner bug refuses instead of
         // wrapping around.
         if (q.MagnitudeBits() > acc_bits - 1) return Status::kPrecisionUnreachable;
-        table[c][k][l] = ToInt128(q);
+        table[c][k][l] = internal::ToInt128(q);
         all_exact = all_exact && entry_exact;
       }
     }

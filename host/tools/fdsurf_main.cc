@@ -360,17 +360,10 @@ int RunPlot(const PlotOptions& o, bool render_only) {
   if (format == "json") content = WriteStrokesJson(path);
   const std::string png = render_only ? o.output : o.png;
   if (!png.empty()) RenderPng(path, o.png_width, outputs.Stage(png));
-  if (!render_only) {
-    if (o.output == "-") {
-      outputs.Commit();
-      std::fwrite(content.data(), 1, content.size(), stdout);
-    } else {
-      WriteFile(outputs.Stage(o.output), content);
-      outputs.Commit();
-    }
-  } else {
-    outputs.Commit();
-  }
+  const bool to_stdout = !render_only && o.output == "-";
+  if (!render_only && !to_stdout) WriteFile(outputs.Stage(o.output), content);
+  outputs.Commit();
+  if (to_stdout) std::fwrite(content.data(), 1, content.size(), stdout);
   if (!o.quiet) {
     std::fprintf(
         stderr,
@@ -385,7 +378,7 @@ int RunPlot(const PlotOptions& o, bool render_only) {
                    plan.pen_down_before, plan.pen_down_after, work_units.c_str(),
                    plan.pen_up_before, plan.pen_up_after, work_units.c_str());
     }
-    if (!render_only && o.output != "-") {
+    if (!render_only && !to_stdout) {
       std::fprintf(stderr, "wrote %s (%s, page %s x %s %s)\n", o.output.c_str(), format.c_str(),
                    Number(path.width).c_str(), Number(path.height).c_str(), work_units.c_str());
     }

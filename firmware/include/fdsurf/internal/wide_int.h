@@ -10,6 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/int128.h"
+
 namespace fdsurf {
 namespace internal {
 
@@ -215,6 +217,26 @@ class WideInt {
  private:
   uint32_t limb_[kLimbs] = {};
 };
+
+/// The low 128 bits of a WideInt (the caller has proven the value fits).
+template <int kLimbs>
+Int128 ToInt128(const WideInt<kLimbs>& w) {
+  static_assert(kLimbs >= 4, "at least 128 bits");
+  Int128 v;
+  v.lo = static_cast<uint64_t>(w.limb(0)) | (static_cast<uint64_t>(w.limb(1)) << 32);
+  v.hi = static_cast<uint64_t>(w.limb(2)) | (static_cast<uint64_t>(w.limb(3)) << 32);
+  return v;
+}
+
+/// An Int128 as a 4-limb WideInt.
+inline WideInt<4> FromInt128(const Int128& v) {
+  WideInt<4> w;
+  w.set_limb(0, static_cast<uint32_t>(v.lo));
+  w.set_limb(1, static_cast<uint32_t>(v.lo >> 32));
+  w.set_limb(2, static_cast<uint32_t>(v.hi));
+  w.set_limb(3, static_cast<uint32_t>(v.hi >> 32));
+  return w;
+}
 
 }  // namespace internal
 }  // namespace fdsurf
