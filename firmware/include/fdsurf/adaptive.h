@@ -182,6 +182,86 @@ inline void HalveStep(Acc* d) {
 
 }  // namespace internal
 
+/// Steps a prepared adaptive curve one point at a time, with accumulator Acc
+/// (int64_t only when format.acc_bits == 64, else Int128). Resumable, so a
+/// motion loop can pull points as it needs them; AdaptiveCurveStepper wraps
+/// it in a callback loop.
+template <typename Acc, int kDims>
+class AdaptiveCurveCursor {
+ public:
+  AdaptiveCurveCursor() = default;
+  explicit AdaptiveCurveCursor(const PreparedAdaptiveCurve<kDims>& curve) { Reset(curve); }
+
+  /// Starts over on `curve`.
+  void Reset(const PreparedAdaptiveCurve<kDims>& curve) {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+    }
+    internal::Load(curve.chord_limit, &chord_limit_);
+    internal::Load(curve.step_limit, &step_limit_);
+    quarter_chord_limit_ = internal::ShiftRightArithmetic(chord_limit_, 2);
+    frac_bits_ = curve.format.frac_bits;
+    end_ = uint32_t{1} << curve.finest_level;
+    position_ = 0;
+    step_ = 1;
+    step_exact_ = curve.mode == AdaptiveMode::kStepExact;
+    started_ = false;
+    for (int c = 0; c < kDims; ++c) last_[c] = RoundToQuanta(d_[c][0], frac_bits_);
+  }
+
+  /// The next point in whole quanta and its position in units of
+  /// 2^-finest_level of the parameter (0 first, 2^finest_level last).
+  /// Returns false after the last point.
+  bool Next(int32_t (&point)[kDims], uint32_t* position) {
+    if (!started_) {
+      started_ = true;
+      for (int c = 0; c < kDims; ++c) point[c] = last_[c];
+      *position = 0;
+      return true;
+    }
+    while (position_ < end_) {
+      // Halve when the step fails or would overshoot t = 1. The planner
+      // proved the finest step always passes, so this stops at 1 at the latest.
+      while (step_ > 1 && (step_ > end_ - position_ ||
+                           !internal::StepFits(d_, chord_limit_, step_limit_, step_exact_))) {
+        for (int c = 0; c < kDims; ++c) internal::HalveStep(d_[c]);
+        step_ >>= 1;
+      }
+      while (step_ <= (end_ - position_) / 2 &&
+             internal::DoubledStepFits(d_, quarter_chord_limit_, step_limit_, step_exact_)) {
+        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d_[c]);
+        step_ <<= 1;
+      }
+      for (int c = 0; c < kDims; ++c) internal::Step(d_[c]);
+      position_ += step_;
+      bool moved = !step_exact_;
+      for (int c = 0; c < kDims; ++c) {
+        point[c] = RoundToQuanta(d_[c][0], frac_bits_);
+        moved = moved || point[c] != last_[c];
+      }
+      if (moved) {
+        for (int c = 0; c < kDims; ++c) last_[c] = point[c];
+        *position = position_;
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  Acc d_[kDims][4];
+  Acc chord_limit_;
+  Acc quarter_chord_limit_;
+  Acc step_limit_;
+  int32_t last_[kDims];
+  uint32_t end_;
+  uint32_t position_;
+  uint32_t step_;  // in units of the finest step
+  uint8_t frac_bits_;
+  bool step_exact_;
+  bool started_;
+};
+
 /// Steps a prepared adaptive curve with accumulator Acc (int64_t only when
 /// format.acc_bits == 64, else Int128). Sink is called as
 /// sink(position, point): position in units of 2^-finest_level of the
@@ -190,68 +270,18 @@ inline void HalveStep(Acc* d) {
 template <typename Acc, int kDims>
 class AdaptiveCurveStepper {
  public:
-  explicit AdaptiveCurveStepper(const PreparedAdaptiveCurve<kDims>& curve)
-      : frac_bits_(curve.format.frac_bits),
-        finest_level_(curve.finest_level),
-        step_exact_(curve.mode == AdaptiveMode::kStepExact) {
-    for (int c = 0; c < kDims; ++c) {
-      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
-    }
-    internal::Load(curve.chord_limit, &chord_limit_);
-    internal::Load(curve.step_limit, &step_limit_);
-    quarter_chord_limit_ = internal::ShiftRightArithmetic(chord_limit_, 2);
-  }
+  explicit AdaptiveCurveStepper(const PreparedAdaptiveCurve<kDims>& curve) : curve_(curve) {}
 
   template <typename Sink>
   void ForEachPoint(Sink&& sink) const {
-    Acc d[kDims][4];
-    for (int c = 0; c < kDims; ++c) {
-      for (int k = 0; k < 4; ++k) d[c][k] = d_[c][k];
-    }
+    AdaptiveCurveCursor<Acc, kDims> cursor(curve_);
     int32_t point[kDims];
-    int32_t last[kDims];
-    for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(d[c][0], frac_bits_);
-    sink(uint32_t{0}, point);
-    for (int c = 0; c < kDims; ++c) last[c] = point[c];
-
-    const uint32_t end = uint32_t{1} << finest_level_;
     uint32_t position = 0;
-    uint32_t step = 1;  // in units of the finest step
-    while (position < end) {
-      // Halve when the step fails or would overshoot t = 1. The planner
-      // proved the finest step always passes, so this stops at 1 at the latest.
-      while (step > 1 && (step > end - position ||
-                          !internal::StepFits(d, chord_limit_, step_limit_, step_exact_))) {
-        for (int c = 0; c < kDims; ++c) internal::HalveStep(d[c]);
-        step >>= 1;
-      }
-      while (step <= (end - position) / 2 &&
-             internal::DoubledStepFits(d, quarter_chord_limit_, step_limit_, step_exact_)) {
-        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d[c]);
-        step <<= 1;
-      }
-      for (int c = 0; c < kDims; ++c) internal::Step(d[c]);
-      position += step;
-      bool moved = !step_exact_;
-      for (int c = 0; c < kDims; ++c) {
-        point[c] = RoundToQuanta(d[c][0], frac_bits_);
-        moved = moved || point[c] != last[c];
-      }
-      if (moved) {
-        sink(position, point);
-        for (int c = 0; c < kDims; ++c) last[c] = point[c];
-      }
-    }
+    while (cursor.Next(point, &position)) sink(position, point);
   }
 
  private:
-  Acc d_[kDims][4];
-  Acc chord_limit_;
-  Acc quarter_chord_limit_;
-  Acc step_limit_;
-  int frac_bits_;
-  int finest_level_;
-  bool step_exact_;
+  PreparedAdaptiveCurve<kDims> curve_;
 };
 
 }  // namespace fdsurf
