@@ -11,6 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   clang-format clang-tidy
   libcairo2-dev
+  libusb-1.0-0-dev libgpiod-dev gpiod
   python3 hp2xx librsvg2-bin
 )
 # The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.

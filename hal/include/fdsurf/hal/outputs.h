@@ -1,0 +1,97 @@
+// Output-only hardware: the step/dir/enable lines of 2 or 3 stepper drivers
+// (A4988, DRV8825, TMC2208 in step/dir mode, ...) and the pen.
+//
+// Pigweed style (pw_digital_io): non-virtual public methods call private pure
+// virtual Do...() methods; the destructor is protected and non-virtual, so
+// nothing is deleted through these interfaces and freestanding builds need no
+// operator delete. The types expose only what outputs can do: no reads.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fdsurf/hal/io_status.h"
+
+namespace fdsurf {
+namespace hal {
+
+/// Axis a is bit (1 << a) in every mask: X = bit 0, Y = bit 1, Z = bit 2.
+class StepDirOutputs {
+ public:
+  StepDirOutputs(const StepDirOutputs&) = delete;
+  StepDirOutputs& operator=(const StepDirOutputs&) = delete;
+
+  /// The number of axes driven: 2 (X, Y) or 3 (X, Y, Z).
+  uint8_t axes() const { return axes_; }
+
+  /// Energises (true) or releases (false) the motors. Drivers without an
+  /// enable line accept this and do nothing.
+  ///
+  /// Errors:
+  ///   kIoError  the line could not be set (LastError() has the detail).
+  IoStatus SetEnabled(bool enabled) { return DoSetEnabled(enabled); }
+
+  /// Sets every axis's direction: bit a set moves axis a towards negative
+  /// on its following steps, bit a clear towards positive. Backends honour
+  /// the drivers' direction set-up time before the next Step().
+  ///
+  /// Errors:
+  ///   kInvalidArgument  a bit at or above axes() is set; nothing changed.
+  ///   kIoError          a line could not be set.
+  IoStatus SetDirections(uint8_t negative_mask) { return DoSetDirections(negative_mask); }
+
+  /// Sends one step pulse on every axis in `axis_mask` (0: does nothing).
+  /// Returns after the pulse has ended (the STEP lines are low again).
+  ///
+  /// Errors:
+  ///   kInvalidArgument  a bit at or above axes() is set; nothing pulsed.
+  ///   kIoError          a line could not be set; the backend has tried to
+  ///                     bring every STEP line low again.
+  IoStatus Step(uint8_t axis_mask) { return DoStep(axis_mask); }
+
+  /// The detail of the last failed call ("" if none), naming the line.
+  const char* LastError() const { return DoLastError(); }
+
+ protected:
+  explicit StepDirOutputs(uint8_t axes) : axes_(axes) {}
+  ~StepDirOutputs() = default;
+
+  /// The mask of the valid axis bits, (1 << axes()) - 1.
+  uint8_t axis_bits() const { return static_cast<uint8_t>((1u << axes_) - 1u); }
+
+ private:
+  virtual IoStatus DoSetEnabled(bool enabled) = 0;
+  virtual IoStatus DoSetDirections(uint8_t negative_mask) = 0;
+  virtual IoStatus DoStep(uint8_t axis_mask) = 0;
+  virtual const char* DoLastError() const = 0;
+
+  uint8_t axes_;
+};
+
+/// The pen of a plotter (or a spindle/laser on/off line): down draws.
+class PenOutput {
+ public:
+  PenOutput(const PenOutput&) = delete;
+  PenOutput& operator=(const PenOutput&) = delete;
+
+  /// Lowers (true) or lifts (false) the pen. Returns once the command is
+  /// given; the mechanical settling time is the caller's to wait.
+  ///
+  /// Errors:
+  ///   kIoError  the line could not be set (LastError() has the detail).
+  IoStatus SetPen(bool down) { return DoSetPen(down); }
+
+  /// The detail of the last failed call ("" if none).
+  const char* LastError() const { return DoLastError(); }
+
+ protected:
+  PenOutput() = default;
+  ~PenOutput() = default;
+
+ private:
+  virtual IoStatus DoSetPen(bool down) = 0;
+  virtual const char* DoLastError() const = 0;
+};
+
+}  // namespace hal
+}  // namespace fdsurf

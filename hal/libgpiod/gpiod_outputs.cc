@@ -1,0 +1,310 @@
+#include "fdsurf/hal/gpiod_outputs.h"
+
+#include <gpiod.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <initializer_list>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "fdsurf/hal/monotonic_clock.h"
+
+namespace fdsurf {
+namespace hal {
+namespace {
+
+constexpr const char* kStepNames[3] = {"STEPX", "STEPY", "STEPZ"};
+constexpr const char* kDirNames[3] = {"DIRX", "DIRY", "DIRZ"};
+constexpr const char* kLinesSyntax = "STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN";
+
+// The gpiochip* entries of `dev_dir`, in numeric order, for error messages.
+std::string ListChips(const std::string& dev_dir) {
+  std::vector<std::pair<unsigned long, std::string>> chips;
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dev_dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind("gpiochip", 0) != 0) continue;
+    chips.emplace_back(std::strtoul(name.c_str() + 8, nullptr, 10), name);
+  }
+  std::sort(chips.begin(), chips.end());
+  if (chips.empty()) return "no GPIO chips in " + dev_dir;
+  std::string list = "chips present: ";
+  for (size_t i = 0; i < chips.size(); ++i) list += (i > 0 ? ", " : "") + chips[i].second;
+  return list;
+}
+
+std::string ErrnoText(int error) { return std::strerror(error); }
+
+// Joins message parts without a temporary per '+'.
+std::string Cat(std::initializer_list<std::string_view> parts) {
+  std::string text;
+  for (const std::string_view part : parts) text.append(part);
+  return text;
+}
+
+// Parses one LINES field: [!|+]OFFSET, or "-" where allowed.
+bool ParseLine(std::string_view field, bool default_active_low, GpioLine* line) {
+  line->active_low = default_active_low;
+  if (!field.empty() && (field[0] == '!' || field[0] == '+')) {
+    line->active_low = field[0] == '!';
+    field.remove_prefix(1);
+  }
+  if (field.empty() || field.size() > 6) return false;
+  unsigned value = 0;
+  for (const char c : field) {
+    if (c < '0' || c > '9') return false;
+    value = value * 10 + static_cast<unsigned>(c - '0');
+  }
+  line->offset = value;
+  return true;
+}
+
+}  // namespace
+
+bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* error) {
+  std::string quoted(1, '\'');  // built up piecewise: GCC 12 warns (-Wrestrict) on "'" + string
+  quoted.append(spec).push_back('\'');
+  const std::string usage = std::string("expected gpio:CHIP:") + kLinesSyntax +
+                            " (e.g. gpio:gpiochip0:17,27,22,23,24,25)";
+  if (spec.substr(0, 5) != "gpio:") {
+    *error = "gpio device " + quoted + " must start with 'gpio:'; " + usage;
+    return false;
+  }
+  const std::string_view rest = spec.substr(5);
+  const size_t colon = rest.rfind(':');
+  if (colon == std::string_view::npos || colon == 0) {
+    *error = "gpio device " + quoted + " has no " + (colon == 0 ? "CHIP" : "LINES") + "; " + usage;
+    return false;
+  }
+  const std::string_view chip = rest.substr(0, colon);
+  std::string_view lines = rest.substr(colon + 1);
+  std::vector<std::string_view> fields;
+  while (true) {
+    const size_t comma = lines.find(',');
+    fields.push_back(lines.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    lines.remove_prefix(comma + 1);
+  }
+  if (fields.size() != 6 && fields.size() != 8) {
+    *error = "gpio device " + quoted + ": " + std::to_string(fields.size()) +
+             " lines given; expected " + kLinesSyntax + " (6 lines for 2 axes, 8 for 3)";
+    return false;
+  }
+  GpiodConfig parsed = *config;
+  parsed.chip = std::string(chip);
+  parsed.axes = fields.size() == 8 ? 3 : 2;
+  std::vector<std::pair<unsigned, const char*>> used;
+  auto take = [&](std::string_view field, const char* name, bool active_low, GpioLine* line) {
+    if (!ParseLine(field, active_low, line)) {
+      *error = "gpio device " + quoted + ": " + name + " '" + std::string(field) +
+               "' is not a line offset ([!|+]NUMBER" +
+               (std::strcmp(name, "EN") == 0 ? ", or - for none)" : ")");
+      return false;
+    }
+    for (const auto& [offset, other] : used) {
+      if (offset == line->offset) {
+        *error = "gpio device " + quoted + ": line " + std::to_string(offset) + " used twice (" +
+                 other + " and " + name + ")";
+        return false;
+      }
+    }
+    used.emplace_back(line->offset, name);
+    return true;
+  };
+  for (int a = 0; a < parsed.axes; ++a) {
+    if (!take(fields[2 * a], kStepNames[a], false, &parsed.step[a]) ||
+        !take(fields[2 * a + 1], kDirNames[a], false, &parsed.dir[a])) {
+      return false;
+    }
+  }
+  const std::string_view enable = fields[fields.size() - 2];
+  parsed.has_enable = enable != "-";
+  if (parsed.has_enable && !take(enable, "EN", true, &parsed.enable)) return false;
+  if (!take(fields.back(), "PEN", false, &parsed.pen)) return false;
+  *config = std::move(parsed);
+  return true;
+}
+
+GpiodOutputs::GpiodOutputs(const GpiodConfig& config, gpiod_chip* chip)
+    : StepDirOutputs(config.axes), config_(config), chip_(chip) {
+  for (int a = 0; a < config.axes; ++a) {
+    line_config_[line_count_] = config.step[a];
+    line_names_[line_count_++] = kStepNames[a];
+    line_config_[line_count_] = config.dir[a];
+    line_names_[line_count_++] = kDirNames[a];
+  }
+  if (config.has_enable) {
+    enable_index_ = line_count_;
+    line_config_[line_count_] = config.enable;
+    line_names_[line_count_++] = "EN";
+  }
+  pen_index_ = line_count_;
+  line_config_[line_count_] = config.pen;
+  line_names_[line_count_++] = "PEN";
+}
+
+IoStatus GpiodOutputs::Open(const GpiodConfig& config, std::unique_ptr<GpiodOutputs>* outputs,
+                            std::string* error) {
+  outputs->reset();
+  const std::string where = "gpio " + config.chip + ": ";
+  if (config.axes != 2 && config.axes != 3) {
+    *error = where + std::to_string(config.axes) + " axes (2 or 3 supported)";
+    return IoStatus::kInvalidArgument;
+  }
+  errno = 0;
+  gpiod_chip* chip = gpiod_chip_open_lookup(config.chip.c_str());
+  if (chip == nullptr) {
+    const int e = errno;
+    if (e == ENOENT) {
+      *error = "gpio: no GPIO chip '" + config.chip + "' (" + ListChips(config.dev_dir) + ")";
+      return IoStatus::kNotFound;
+    }
+    if (e == EACCES || e == EPERM) {
+      *error = "gpio: permission denied opening GPIO chip '" + config.chip +
+               "' (add your user to the group owning /dev/gpiochip*, e.g. gpio, or add a udev "
+               "rule; see hal/README.md)";
+      return IoStatus::kPermissionDenied;
+    }
+    if (e == ENOTTY || e == EINVAL || e == ENODEV) {
+      *error = "gpio: '" + config.chip + "' is not a GPIO chip (" + ErrnoText(e) + ")";
+      return IoStatus::kInvalidArgument;
+    }
+    *error = "gpio: cannot open GPIO chip '" + config.chip + "': " + ErrnoText(e);
+    return IoStatus::kIoError;
+  }
+  std::unique_ptr<GpiodOutputs> self(new GpiodOutputs(config, chip));
+  const unsigned chip_lines = gpiod_chip_num_lines(chip);
+  for (int i = 0; i < self->line_count_; ++i) {
+    const unsigned offset = self->line_config_[i].offset;
+    const std::string line = "line " + std::to_string(offset) + " (" + self->line_names_[i] + ")";
+    for (int j = 0; j < i; ++j) {
+      if (self->line_config_[j].offset == offset) {
+        *error = where + line + " is also " + self->line_names_[j];
+        return IoStatus::kInvalidArgument;
+      }
+    }
+    if (offset >= chip_lines) {
+      *error = where + line + " does not exist: the chip has " + std::to_string(chip_lines) +
+               " lines (0-" + std::to_string(chip_lines - 1) + ")";
+      return IoStatus::kNotFound;
+    }
+    errno = 0;
+    gpiod_line* handle = gpiod_chip_get_line(chip, offset);
+    if (handle == nullptr) {
+      *error = Cat({where, "cannot get ", line, ": ", ErrnoText(errno)});
+      return IoStatus::kIoError;
+    }
+    auto busy = [&]() {
+      const char* consumer = gpiod_line_consumer(handle);
+      *error = where + line + " is busy: " +
+               (consumer != nullptr && consumer[0] != '\0'
+                    ? std::string("used by '") + consumer + "'"
+                    : std::string("used by another program or driver"));
+      return IoStatus::kBusy;
+    };
+    if (gpiod_line_is_used(handle)) return busy();
+    // Inactive at first: no pulse, positive, motors off, pen up.
+    const int initial = self->line_config_[i].active_low ? 1 : 0;
+    errno = 0;
+    if (gpiod_line_request_output(handle, config.consumer.c_str(), initial) != 0) {
+      const int e = errno;
+      if (e == EBUSY) return busy();
+      if (e == EACCES || e == EPERM) {
+        *error = Cat({where, "permission denied requesting ", line});
+        return IoStatus::kPermissionDenied;
+      }
+      *error = Cat({where, "cannot request ", line, " as an output: ", ErrnoText(e)});
+      return IoStatus::kIoError;
+    }
+    self->lines_[i] = handle;
+  }
+  self->dir_changed_us_ = MonotonicClock::Now();
+  *outputs = std::move(self);
+  return IoStatus::kOk;
+}
+
+GpiodOutputs::~GpiodOutputs() {
+  const bool all_requested = lines_[line_count_ - 1] != nullptr;
+  if (all_requested) {
+    // Leave the machine safe: pen up, motors off (errors cannot be reported).
+    (void)Set(pen_index_, false);
+    if (enable_index_ >= 0) (void)Set(enable_index_, false);
+  }
+  for (gpiod_line* line : lines_) {
+    if (line != nullptr) gpiod_line_release(line);
+  }
+  gpiod_chip_close(chip_);
+}
+
+IoStatus GpiodOutputs::Set(int index, bool active) {
+  const int value = active != line_config_[index].active_low ? 1 : 0;
+  errno = 0;
+  if (gpiod_line_set_value(lines_[index], value) != 0) {
+    last_error_ = "gpio " + config_.chip + ": cannot set line " +
+                  std::to_string(line_config_[index].offset) + " (" + line_names_[index] + ") to " +
+                  std::to_string(value) + ": " + ErrnoText(errno);
+    return IoStatus::kIoError;
+  }
+  return IoStatus::kOk;
+}
+
+IoStatus GpiodOutputs::CheckMask(uint8_t mask, const char* what) {
+  if ((mask & ~axis_bits()) == 0) return IoStatus::kOk;
+  last_error_ = "gpio " + config_.chip + ": " + what + " mask " + std::to_string(mask) +
+                " has bits beyond " + std::to_string(axes()) + " axes";
+  return IoStatus::kInvalidArgument;
+}
+
+IoStatus GpiodOutputs::DoSetEnabled(bool enabled) {
+  if (enable_index_ < 0) return IoStatus::kOk;
+  return Set(enable_index_, enabled);
+}
+
+IoStatus GpiodOutputs::DoSetDirections(uint8_t negative_mask) {
+  if (const IoStatus status = CheckMask(negative_mask, "direction"); status != IoStatus::kOk) {
+    return status;
+  }
+  for (int a = 0; a < axes(); ++a) {
+    const bool negative = (negative_mask >> a & 1) != 0;
+    if (negative == ((negative_mask_ >> a & 1) != 0)) continue;
+    if (const IoStatus status = Set(2 * a + 1, negative); status != IoStatus::kOk) return status;
+    negative_mask_ = static_cast<uint8_t>(negative_mask_ ^ (1u << a));
+    dir_changed_us_ = MonotonicClock::Now();
+  }
+  return IoStatus::kOk;
+}
+
+IoStatus GpiodOutputs::DoStep(uint8_t axis_mask) {
+  if (const IoStatus status = CheckMask(axis_mask, "step"); status != IoStatus::kOk) return status;
+  if (axis_mask == 0) return IoStatus::kOk;
+  // DIR set-up time, and a low time as long as the high time since the last pulse.
+  MonotonicClock::BusyWaitUntil(
+      std::max(dir_changed_us_ + config_.dir_setup_us, step_low_us_ + config_.min_pulse_us));
+  IoStatus result = IoStatus::kOk;
+  for (int a = 0; a < axes() && result == IoStatus::kOk; ++a) {
+    if ((axis_mask >> a & 1) != 0) result = Set(2 * a, true);
+  }
+  const uint64_t high_us = MonotonicClock::Now();
+  MonotonicClock::BusyWaitUntil(high_us + config_.min_pulse_us);
+  // Bring every pulsed STEP line low, even after a failure, keeping the first error.
+  const bool failed_high = result != IoStatus::kOk;
+  const std::string first_error = failed_high ? last_error_ : std::string();
+  for (int a = 0; a < axes(); ++a) {
+    if ((axis_mask >> a & 1) == 0) continue;
+    const IoStatus status = Set(2 * a, false);
+    if (result == IoStatus::kOk) result = status;
+  }
+  step_low_us_ = MonotonicClock::Now();
+  if (failed_high) last_error_ = first_error;
+  return result;
+}
+
+IoStatus GpiodOutputs::DoSetPen(bool down) { return Set(pen_index_, down); }
+
+}  // namespace hal
+}  // namespace fdsurf

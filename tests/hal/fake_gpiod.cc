@@ -1,0 +1,104 @@
+#include "fake_gpiod.h"
+
+#include <gpiod.h>
+
+#include <cerrno>
+#include <string>
+
+#include "fdsurf/hal/monotonic_clock.h"
+
+namespace fdsurf::hal::testing {
+
+FakeGpio* g_fake_gpio = nullptr;
+
+FakeGpioChip& FakeGpio::AddChip(const std::string& descriptor, unsigned count) {
+  FakeGpioChip& chip = chips[descriptor];
+  chip.lines.resize(count);
+  for (unsigned i = 0; i < count; ++i) chip.lines[i].offset = i;
+  return chip;
+}
+
+namespace {
+
+FakeGpioChip* Chip(gpiod_chip* chip) { return reinterpret_cast<FakeGpioChip*>(chip); }
+FakeGpioLine* Line(gpiod_line* line) { return reinterpret_cast<FakeGpioLine*>(line); }
+
+}  // namespace
+}  // namespace fdsurf::hal::testing
+
+using fdsurf::hal::testing::Chip;
+using fdsurf::hal::testing::g_fake_gpio;
+using fdsurf::hal::testing::Line;
+
+extern "C" {
+
+gpiod_chip* __wrap_gpiod_chip_open_lookup(const char* descr) {
+  g_fake_gpio->log.push_back(std::string("lookup ") + descr);
+  auto it = g_fake_gpio->chips.find(descr);
+  if (it == g_fake_gpio->chips.end()) {
+    errno = g_fake_gpio->missing_errno;
+    return nullptr;
+  }
+  it->second.open = true;
+  return reinterpret_cast<gpiod_chip*>(&it->second);
+}
+
+void __wrap_gpiod_chip_close(gpiod_chip* chip) {
+  g_fake_gpio->log.emplace_back("close");
+  Chip(chip)->open = false;
+}
+
+unsigned int __wrap_gpiod_chip_num_lines(gpiod_chip* chip) {
+  return static_cast<unsigned>(Chip(chip)->lines.size());
+}
+
+gpiod_line* __wrap_gpiod_chip_get_line(gpiod_chip* chip, unsigned int offset) {
+  if (offset >= Chip(chip)->lines.size()) {
+    errno = EINVAL;
+    return nullptr;
+  }
+  return reinterpret_cast<gpiod_line*>(&Chip(chip)->lines[offset]);
+}
+
+bool __wrap_gpiod_line_is_used(gpiod_line* line) { return Line(line)->used; }
+
+const char* __wrap_gpiod_line_consumer(gpiod_line* line) {
+  return Line(line)->consumer.empty() ? nullptr : Line(line)->consumer.c_str();
+}
+
+int __wrap_gpiod_line_request_output(gpiod_line* line, const char* consumer, int default_val) {
+  if (Line(line)->request_errno != 0) {
+    errno = Line(line)->request_errno;
+    return -1;
+  }
+  g_fake_gpio->log.push_back("request " + std::to_string(Line(line)->offset) + " " + consumer +
+                             " " + std::to_string(default_val));
+  Line(line)->requested = true;
+  Line(line)->value = default_val;
+  return 0;
+}
+
+int __wrap_gpiod_line_set_value(gpiod_line* line, int value) {
+  const bool fails = Line(line)->set_errno != 0 &&
+                     (Line(line)->set_fails_for < 0 || Line(line)->set_fails_for == value);
+  g_fake_gpio->log.push_back("set " + std::to_string(Line(line)->offset) + "=" +
+                             std::to_string(value) + (fails ? " (fails)" : ""));
+  g_fake_gpio->set_times_us.push_back(fdsurf::hal::MonotonicClock::Now());
+  if (!Line(line)->requested) {
+    errno = EPERM;
+    return -1;
+  }
+  if (fails) {
+    errno = Line(line)->set_errno;
+    return -1;
+  }
+  Line(line)->value = value;
+  return 0;
+}
+
+void __wrap_gpiod_line_release(gpiod_line* line) {
+  g_fake_gpio->log.push_back("release " + std::to_string(Line(line)->offset));
+  Line(line)->requested = false;
+}
+
+}  // extern "C"
