@@ -1,0 +1,214 @@
+// The device protocol's messages, decoded: what the host asks the device to
+// do, and what the device answers. docs/protocol.md gives the wire format
+// (COBS frames with a CRC-32, sequence numbers, acknowledgements, credits);
+// this header is the contract between the protocol code and the device that
+// executes the commands.
+//
+// All lengths, positions and rates are in motor steps: the host maps its
+// drawing into steps before it sends anything, so the device never scales.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fdsurf/basis.h"
+#include "fdsurf/forward_difference.h"
+
+namespace fdsurf {
+namespace protocol {
+
+/// Protocol version spoken by this code; HELLO carries it.
+constexpr uint8_t kProtocolVersion = 1;
+/// Largest decoded frame: type, sequence number, body and CRC together.
+constexpr size_t kMaxFrameBytes = 512;
+/// Largest number of axes a device drives (X, Y and optionally Z).
+constexpr int kMaxAxes = 3;
+
+/// Frame types. Host → device below 0x80, device → host from 0x80 on.
+/// Sequenced commands (0x10..0x1F) are queued and executed exactly once in
+/// sequence order; the others are answered at once.
+enum class MessageType : uint8_t {
+  kHello = 0x01,        ///< version and flags; answered by kHelloReply
+  kStatusQuery = 0x02,  ///< answered by kStatusReport
+  kStop = 0x03,         ///< stop motion, drop the queue; answered by kAck
+
+  kConfig = 0x10,  ///< MachineConfig
+  kPatch = 0x11,   ///< PatchCommand
+  kCurve = 0x12,   ///< CurveCommand
+  kMove = 0x13,    ///< MoveCommand
+  kPen = 0x14,     ///< PenCommand
+
+  kHelloReply = 0x81,
+  kStatusReport = 0x82,
+  kAck = 0x83,
+  kNak = 0x84,
+  kError = 0x85,
+};
+
+/// Whether a message type is a sequenced (queued, exactly-once) command.
+inline bool IsSequenced(MessageType type) {
+  return static_cast<uint8_t>(type) >= 0x10 && static_cast<uint8_t>(type) <= 0x1F;
+}
+
+/// Flags of kHello.
+constexpr uint8_t kHelloFlagNewSession = 0x01;  ///< forget sequence state and queue, start at seq 0
+/// Every flag this version knows; a HELLO with another bit set is refused.
+constexpr uint8_t kHelloKnownFlags = kHelloFlagNewSession;
+
+/// kHello's body. The frame's seq field carries a token the reply echoes.
+struct Hello {
+  uint8_t version;
+  uint8_t flags;
+};
+
+/// The machine the host drives, in steps. Sent once per job (sequenced, so
+/// it takes effect in order with the motion commands).
+struct MachineConfig {
+  /// 2 (X, Y) or 3 (X, Y, Z).
+  uint8_t axes;
+  /// Informational scale, steps per metre, > 0 per used axis.
+  uint32_t steps_per_meter[kMaxAxes];
+  /// Each axis moves within [0, travel_steps], 1 ≤ travel_steps < 2^30.
+  int32_t travel_steps[kMaxAxes];
+  /// Path speed limit in steps per second, 1 ≤ max_rate ≤ the device's tick rate.
+  uint32_t max_rate;
+  /// Path acceleration limit in steps per second², ≥ 1.
+  uint32_t accel;
+  /// Rest after every pen change before motion resumes, milliseconds.
+  uint16_t pen_delay_ms;
+};
+
+/// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a
+/// step-exact adaptive forward-difference path within tolerance, with
+/// pen-up travel between lines (serpentine order).
+struct PatchCommand {
+  Basis basis;
+  /// Equal to the configured axes.
+  uint8_t dims;
+  /// 0 (family left out) or 2..kMaxPatchSteps + 1; not both 0.
+  uint16_t lines_s;
+  uint16_t lines_t;
+  /// Euclidean tolerance in 2^-8 steps (as AdaptiveSettings::tolerance_q8).
+  uint32_t tolerance_q8;
+  /// Geometry in steps, Q47.16; only [0, dims) used.
+  PatchGeometry1 geometry[kMaxAxes];
+};
+
+/// Draw one cubic curve with the current pen state, starting with a straight
+/// move from the current position to the curve's start if they differ.
+struct CurveCommand {
+  Basis basis;
+  uint8_t dims;
+  uint32_t tolerance_q8;
+  CurveGeometry1 geometry[kMaxAxes];
+};
+
+/// A straight move to `target` (steps) with the current pen state.
+struct MoveCommand {
+  int32_t target[kMaxAxes];
+};
+
+struct PenCommand {
+  bool down;
+};
+
+/// A decoded sequenced command.
+struct Command {
+  MessageType type;
+  uint16_t seq;
+  union Body {
+    Body() : pen{false} {}
+    MachineConfig config;
+    PatchCommand patch;
+    CurveCommand curve;
+    MoveCommand move;
+    PenCommand pen;
+  } body;
+};
+
+/// Why a frame was refused (kError body), or why a kNak was sent.
+enum class ErrorCode : uint8_t {
+  kNone = 0,
+  kBadLength = 1,           ///< body shorter or longer than its type requires
+  kUnknownType = 2,         ///< no such message type
+  kBadField = 3,            ///< a field is out of range; `field` says which
+  kUnsupportedVersion = 4,  ///< HELLO with another protocol version
+  kNotConfigured = 5,       ///< motion command before any kConfig
+  kDimsMismatch = 6,        ///< dims differ from the configured axes
+  kOutOfTravel = 7,         ///< the path could leave [0, travel_steps]
+  kPlannerRefused = 8,      ///< the engine refused it; `detail` is the fdsurf::Status
+  kQueueFull = 9,           ///< no credit left (the host overran its window)
+  kOutOfOrder = 10,         ///< kNak: a sequence number ahead of the expected one
+  kStopped = 11,            ///< a command arrived while a stop was in progress
+  kOutputFailed = 12,       ///< a step or pen output failed (status: detail = hal::IoStatus)
+};
+
+/// A short, stable name ("bad length", ...).
+const char* ErrorName(ErrorCode code);
+
+/// Device state in kStatusReport.
+enum class DeviceState : uint8_t {
+  kIdle = 0,      ///< queue empty, at rest
+  kRunning = 1,   ///< executing or about to
+  kStopping = 2,  ///< decelerating after kStop
+  kFault = 3,     ///< an execution error; `error` says which
+};
+
+struct HelloReply {
+  uint8_t version;
+  /// The sequence number the device expects next (resume point).
+  uint16_t next_seq;
+  /// Free command slots now, and the queue's capacity.
+  uint8_t credits;
+  uint8_t queue_capacity;
+  /// Motion ticks per second (the step clock); the largest max_rate.
+  uint32_t tick_hz;
+  /// Axes the device drives; largest grid it evaluates.
+  uint8_t max_axes;
+  uint16_t max_lines;
+};
+
+struct StatusReport {
+  DeviceState state;
+  ErrorCode error;
+  uint8_t error_detail;
+  bool pen_down;
+  int32_t position[kMaxAxes];
+  /// Commands waiting (not yet started) and free slots.
+  uint8_t queued;
+  uint8_t credits;
+  /// The next expected sequence number, and how many sequenced commands have
+  /// finished executing since the session began (wraps at 2^32).
+  uint16_t next_seq;
+  uint32_t executed;
+  /// Unit moves (ticks that stepped) since the session began.
+  uint32_t moves;
+};
+
+struct Ack {
+  /// Cumulative: every seq before this one is accepted.
+  uint16_t next_seq;
+  uint8_t credits;
+};
+
+struct Nak {
+  uint16_t next_seq;
+  uint8_t credits;
+  ErrorCode reason;
+};
+
+/// Every reply's frame seq field echoes the seq (or, for HELLO, STATUS_QUERY
+/// and STOP, the token) of the frame it answers; ACK, NAK and ERROR bodies
+/// carry the fields below.
+struct ErrorReply {
+  /// The refused frame's sequence number (its token for unsequenced frames);
+  /// on the wire this is the frame's seq field, not part of the body.
+  uint16_t seq;
+  ErrorCode code;
+  /// For kBadField the field's index in the body (docs/protocol.md numbers
+  /// them); for kPlannerRefused the fdsurf::Status.
+  uint8_t detail;
+};
+
+}  // namespace protocol
+}  // namespace fdsurf

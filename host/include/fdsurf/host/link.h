@@ -1,0 +1,191 @@
+// The host's end of the device link: a reliable, in-order, exactly-once
+// sender of sequenced commands over an unreliable byte stream (go-back-N
+// with cumulative ACKs, NAK-triggered fast retransmission, credit-based flow
+// control; docs/protocol.md).
+//
+// HostLink does no I/O and reads no clock: every call takes the current time
+// in microseconds, Poll() appends the bytes to send now and OnBytes() takes
+// what arrived. The same code drives a simulated device in virtual time and
+// a USB serial port in real time.
+//
+//   HostLink link(options);
+//   link.Enqueue(command, "patch 3 (teapot.bpt:12)");   // any number
+//   while (!link.Finished() && !link.Failed()) {
+//     std::vector<uint8_t> out;
+//     link.Poll(now_us, &out);     // write `out` to the port
+//     link.OnBytes(in, n, now_us); // whatever the port returned
+//   }
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fdsurf/protocol/codec.h"
+#include "fdsurf/protocol/frame.h"
+#include "fdsurf/protocol/messages.h"
+
+namespace fdsurf::host {
+
+struct HostLinkOptions {
+  /// Most commands in flight (sent, not yet acknowledged); the device's
+  /// credits may lower it further. 1..0x7FFF.
+  uint16_t window = 16;
+  /// Time without progress after which the oldest unacknowledged frame
+  /// (and everything after it) is sent again; also HELLO and status queries.
+  /// The timer runs from the later of the frame's last transmission and the
+  /// last acknowledgement that released a command.
+  uint64_t retransmit_timeout_us = 200'000;
+  /// Consecutive timeouts without any progress before Failed().
+  int max_retries = 20;
+  /// Status queries while nothing is in flight (waiting for credit or for
+  /// the device to finish).
+  uint64_t status_interval_us = 50'000;
+  /// HELLO with kHelloFlagNewSession: the device drops its queue and starts
+  /// at seq 0. Without it the host continues at the device's next_seq.
+  bool new_session = true;
+};
+
+struct HostLinkStats {
+  uint64_t frames_sent = 0;    ///< every frame: commands, HELLO, queries, STOP
+  uint64_t bytes_sent = 0;     ///< on the wire, COBS and delimiters included
+  uint64_t commands_sent = 0;  ///< first transmissions of commands
+  uint64_t retransmitted = 0;  ///< later transmissions of commands
+  uint64_t hellos_sent = 0;
+  uint64_t status_queries = 0;
+  uint64_t frames_received = 0;  ///< valid (CRC-checked, decodable) replies
+  uint64_t bytes_received = 0;
+  uint64_t bad_replies = 0;  ///< CRC-valid frames that did not decode
+  uint64_t acks = 0;
+  uint64_t duplicate_acks = 0;  ///< ACKs that acknowledged nothing new
+  uint64_t naks = 0;
+  uint64_t queue_full_naks = 0;
+  uint64_t timeouts = 0;
+};
+
+class HostLink {
+ public:
+  explicit HostLink(HostLinkOptions options = {});
+
+  /// Appends a sequenced command to the job (its seq is assigned here, in
+  /// order). `label` names it in error messages ("patch 3 (teapot.bpt:12)").
+  /// The command is validated exactly as the device's decoder would: a
+  /// result other than ok() means it was not enqueued (the field index is
+  /// that of docs/protocol.md).
+  [[nodiscard]] protocol::DecodeResult Enqueue(const protocol::Command& command,
+                                               std::string label = {});
+
+  /// Takes bytes received from the device.
+  void OnBytes(const uint8_t* data, size_t size, uint64_t now_us);
+
+  /// Appends to `out` whatever should be sent now: HELLO until answered,
+  /// retransmissions after a timeout or NAK, new commands within the window
+  /// and the device's credits, STOP, status queries.
+  void Poll(uint64_t now_us, std::vector<uint8_t>* out);
+
+  /// The earliest time at which Poll() will have something to do if no bytes
+  /// arrive meanwhile (for event-driven and virtual-time loops); `now_us`
+  /// if it has something to do now, UINT64_MAX if nothing is pending.
+  uint64_t NextPollUs(uint64_t now_us) const;
+
+  /// After a reconnect: re-handshake with a resume HELLO (no new-session
+  /// flag), then continue from the device's next_seq. Drops any partly
+  /// received frame. Fails if the device's next_seq is not within what the
+  /// host has sent (the device lost the session).
+  void Resume();
+
+  /// Sends STOP (repeated until acknowledged) and no further commands.
+  void RequestStop();
+  bool StopAcknowledged() const { return stop_acked_; }
+
+  /// Handshake done (a HELLO_REPLY arrived since the last Resume()).
+  bool Connected() const { return state_ == State::kRunning; }
+  /// Every enqueued command is acknowledged by the device.
+  bool AllAcknowledged() const { return state_ == State::kRunning && queue_.empty(); }
+  /// All acknowledged and a status report (requested after the last
+  /// acknowledgement) shows every command executed and the device idle.
+  bool Finished() const;
+  bool Failed() const { return state_ == State::kFailed; }
+  /// What went wrong, when Failed().
+  const std::string& error() const { return error_; }
+
+  const HostLinkStats& stats() const { return stats_; }
+  /// Frames the host's decoder dropped (CRC, COBS, overlong).
+  const protocol::FrameDecoderStats& frame_stats() const { return decoder_.stats(); }
+  const std::optional<protocol::StatusReport>& status() const { return status_; }
+  const std::optional<protocol::HelloReply>& hello() const { return hello_; }
+  /// Commands enqueued since construction, and acknowledged.
+  uint64_t enqueued() const { return enqueued_; }
+  uint64_t acknowledged() const { return enqueued_ - queue_.size(); }
+
+ private:
+  enum class State { kHandshake, kRunning, kFailed };
+  struct Pending {
+    protocol::MessageType type;
+    std::vector<uint8_t> body;
+    std::string label;
+    uint64_t last_sent_us = 0;
+  };
+
+  void HandleReply(const protocol::Reply& reply, uint64_t now_us);
+  void HandleHelloReply(const protocol::Reply& reply, uint64_t now_us);
+  // Cumulative acknowledgement: every seq before next_seq is accepted.
+  // Returns false (and changes nothing) if next_seq is not one the host
+  // has sent.
+  bool Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us);
+  void HandleError(const protocol::Reply& reply);
+  void Fail(std::string message);
+  void Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out);
+  void SendHello(uint64_t now_us, std::vector<uint8_t>* out);
+  void SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out);
+  // Counts a timeout; returns true (and fails) after max_retries in a row.
+  bool Timeout();
+  std::string Describe(size_t index) const;
+  uint16_t SeqOf(size_t index) const { return static_cast<uint16_t>(base_seq_ + index); }
+  size_t SendLimit() const;
+  uint64_t RetransmitTimerStart() const;
+
+  HostLinkOptions options_;
+  State state_ = State::kHandshake;
+  std::string error_;
+  bool session_started_ = false;  // a handshake has set base_seq_
+
+  // Unacknowledged commands; queue_[i] has seq base_seq_ + i.
+  std::deque<Pending> queue_;
+  uint16_t base_seq_ = 0;
+  size_t next_send_ = 0;  // queue_ index of the next frame to transmit
+  size_t sent_ = 0;       // queue_ entries transmitted at least once
+  uint8_t credits_ = 0;
+  bool fast_retransmit_done_ = false;  // one NAK rewind per base_seq_
+  uint64_t progress_us_ = 0;           // when base_seq_ last advanced
+
+  uint16_t next_token_ = 1;
+  uint16_t hello_token_ = 0;
+  uint64_t hello_sent_us_ = 0;
+  bool hello_sent_ = false;
+  bool resume_ = false;
+
+  uint16_t status_token_ = 0;
+  bool status_outstanding_ = false;
+  uint64_t status_sent_us_ = 0;
+  bool status_fresh_ = false;  // status_ requested after the last acknowledgement
+
+  bool stop_requested_ = false;
+  bool stop_acked_ = false;
+  uint16_t stop_token_ = 0;
+  uint64_t stop_sent_us_ = 0;
+  bool stop_sent_ = false;
+
+  int retries_ = 0;  // consecutive timeouts without progress
+  uint64_t enqueued_ = 0;
+
+  std::optional<protocol::StatusReport> status_;
+  std::optional<protocol::HelloReply> hello_;
+  protocol::FrameDecoderBuffer<protocol::kMaxFrameBytes> decoder_;
+  HostLinkStats stats_;
+};
+
+}  // namespace fdsurf::host

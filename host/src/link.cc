@@ -1,0 +1,486 @@
+#include "fdsurf/host/link.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <utility>
+
+#include "fdsurf/status.h"
+
+namespace fdsurf::host {
+namespace {
+
+using protocol::ErrorCode;
+using protocol::MessageType;
+
+const char* TypeName(MessageType type) {
+  switch (type) {
+    case MessageType::kHello:
+      return "hello";
+    case MessageType::kStatusQuery:
+      return "status query";
+    case MessageType::kStop:
+      return "stop";
+    case MessageType::kConfig:
+      return "config";
+    case MessageType::kPatch:
+      return "patch";
+    case MessageType::kCurve:
+      return "curve";
+    case MessageType::kMove:
+      return "move";
+    case MessageType::kPen:
+      return "pen";
+    default:
+      return "frame";
+  }
+}
+
+const char* const kAxisNames[] = {"x", "y", "z"};
+
+// The name of field `index` of a command body (docs/protocol.md numbers them).
+std::string FieldName(MessageType type, uint8_t index) {
+  namespace p = protocol;
+  auto axis = [](int a) { return std::string(a < 3 ? kAxisNames[a] : "?"); };
+  switch (type) {
+    case MessageType::kConfig: {
+      if (index == p::kConfigFieldAxes) {
+        return "axes";
+      }
+      if (index >= p::kConfigFieldStepsPerMeter && index < p::kConfigFieldTravel) {
+        return "steps_per_meter[" + axis(index - p::kConfigFieldStepsPerMeter) + "]";
+      }
+      if (index >= p::kConfigFieldTravel && index < p::kConfigFieldMaxRate) {
+        return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
+      }
+      const std::array<const char*, 3> rest = {"max_rate", "accel", "pen_delay_ms"};
+      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldCount) {
+        return rest[index - p::kConfigFieldMaxRate];
+      }
+      break;
+    }
+    case MessageType::kPatch: {
+      const std::array<const char*, 5> head = {"basis", "dims", "lines_s", "lines_t",
+                                               "tolerance_q8"};
+      if (index < p::kPatchFieldGeometry) {
+        return head[index];
+      }
+      const int g = index - p::kPatchFieldGeometry;
+      if (g < 16 * protocol::kMaxAxes) {
+        return "geometry " + axis(g / 16) + "[" + std::to_string(g % 16 / 4) + "][" +
+               std::to_string(g % 4) + "]";
+      }
+      break;
+    }
+    case MessageType::kCurve: {
+      const std::array<const char*, 3> head = {"basis", "dims", "tolerance_q8"};
+      if (index < p::kCurveFieldGeometry) {
+        return head[index];
+      }
+      const int g = index - p::kCurveFieldGeometry;
+      if (g < 4 * protocol::kMaxAxes) {
+        return "geometry " + axis(g / 4) + "[" + std::to_string(g % 4) + "]";
+      }
+      break;
+    }
+    case MessageType::kMove:
+      if (index < p::kMoveFieldCount) {
+        return "target[" + axis(index) + "]";
+      }
+      break;
+    case MessageType::kPen:
+      if (index == p::kPenFieldDown) {
+        return "down";
+      }
+      break;
+    default:
+      break;
+  }
+  return "end of body";
+}
+
+}  // namespace
+
+HostLink::HostLink(HostLinkOptions options) : options_(options) {
+  options_.window = std::clamp<uint16_t>(options_.window, 1, 0x7FFF);
+  options_.max_retries = std::max(options_.max_retries, 0);
+}
+
+protocol::DecodeResult HostLink::Enqueue(const protocol::Command& command, std::string label) {
+  const protocol::DecodeResult result = protocol::ValidateCommand(command);
+  if (!result.ok()) {
+    return result;
+  }
+  Pending pending;
+  pending.type = command.type;
+  pending.body.resize(protocol::kMaxBodyBytes);
+  pending.body.resize(
+      protocol::EncodeCommandBody(command, pending.body.data(), pending.body.size()));
+  pending.label = std::move(label);
+  queue_.push_back(std::move(pending));
+  ++enqueued_;
+  return result;
+}
+
+void HostLink::OnBytes(const uint8_t* data, size_t size, uint64_t now_us) {
+  stats_.bytes_received += size;
+  for (size_t i = 0; i < size; ++i) {
+    if (!decoder_.OnByte(data[i])) {
+      continue;
+    }
+    protocol::Reply reply;
+    if (!protocol::DecodeReply(decoder_.frame(), &reply).ok()) {
+      ++stats_.bad_replies;
+      continue;
+    }
+    ++stats_.frames_received;
+    if (state_ != State::kFailed) {
+      HandleReply(reply, now_us);
+    }
+  }
+}
+
+void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
+  switch (reply.type) {
+    case MessageType::kHelloReply:
+      HandleHelloReply(reply, now_us);
+      return;
+    case MessageType::kError:
+      HandleError(reply);
+      return;
+    default:
+      break;
+  }
+  if (state_ != State::kRunning) {
+    return;  // left over from before a Resume(): the handshake decides
+  }
+  switch (reply.type) {
+    case MessageType::kAck: {
+      ++stats_.acks;
+      const uint16_t before = base_seq_;
+      if (Acknowledge(reply.body.ack.next_seq, reply.body.ack.credits, now_us) &&
+          before == base_seq_) {
+        ++stats_.duplicate_acks;
+      }
+      if (stop_sent_ && reply.seq == stop_token_) {
+        stop_acked_ = true;
+      }
+      return;
+    }
+    case MessageType::kNak: {
+      ++stats_.naks;
+      const protocol::Nak& nak = reply.body.nak;
+      if (!Acknowledge(nak.next_seq, nak.credits, now_us)) {
+        return;
+      }
+      if (nak.reason == ErrorCode::kQueueFull) {
+        // The device refused base_seq_ for want of credit and drops what
+        // follows: send again from there once credit is back.
+        ++stats_.queue_full_naks;
+        next_send_ = 0;
+      } else if (!fast_retransmit_done_) {
+        // Go back to the device's next_seq at once. The other frames of
+        // the old window still draw NAKs for the same seq; only the first
+        // rewinds (per acknowledged position), else every stale NAK would
+        // resend the whole window again.
+        fast_retransmit_done_ = true;
+        next_send_ = 0;
+      }
+      return;
+    }
+    case MessageType::kStatusReport: {
+      if (!status_outstanding_ || reply.seq != status_token_) {
+        return;  // an old query's answer
+      }
+      status_outstanding_ = false;
+      retries_ = 0;
+      status_ = reply.body.status;
+      Acknowledge(status_->next_seq, status_->credits, now_us);
+      if (status_->state == protocol::DeviceState::kFault) {
+        Fail("device fault: " + std::string(protocol::ErrorName(status_->error)) + " (detail " +
+             std::to_string(status_->error_detail) + ")");
+      }
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+void HostLink::HandleHelloReply(const protocol::Reply& reply, uint64_t now_us) {
+  if (state_ != State::kHandshake || !hello_sent_ || reply.seq != hello_token_) {
+    return;
+  }
+  const protocol::HelloReply& h = reply.body.hello;
+  hello_ = h;
+  if (h.version != protocol::kProtocolVersion) {
+    Fail("protocol version mismatch: device speaks " + std::to_string(h.version) + ", host " +
+         std::to_string(protocol::kProtocolVersion));
+    return;
+  }
+  if (!session_started_) {
+    session_started_ = true;
+    if (options_.new_session && h.next_seq != 0) {
+      Fail("device did not start a new session (next_seq " + std::to_string(h.next_seq) + ")");
+      return;
+    }
+    base_seq_ = h.next_seq;
+  } else if (!Acknowledge(h.next_seq, h.credits, now_us)) {
+    Fail("device lost the session on resume: it expects seq " + std::to_string(h.next_seq) +
+         ", the host's unacknowledged commands start at seq " + std::to_string(base_seq_));
+    return;
+  }
+  credits_ = h.credits;
+  next_send_ = 0;
+  retries_ = 0;
+  fast_retransmit_done_ = false;
+  state_ = State::kRunning;
+}
+
+bool HostLink::Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us) {
+  const size_t advance = static_cast<uint16_t>(next_seq - base_seq_);
+  if (advance > sent_) {
+    return false;  // behind base_seq_ (stale) or beyond anything sent (bogus)
+  }
+  if (advance > 0) {
+    queue_.erase(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(advance));
+    base_seq_ = next_seq;
+    next_send_ = next_send_ > advance ? next_send_ - advance : 0;
+    sent_ -= advance;
+    retries_ = 0;
+    fast_retransmit_done_ = false;
+    progress_us_ = now_us;
+  }
+  credits_ = credits;
+  return true;
+}
+
+void HostLink::HandleError(const protocol::Reply& reply) {
+  const protocol::ErrorReply& e = reply.body.error;
+  std::string what;
+  MessageType type = MessageType::kHello;
+  if (state_ == State::kHandshake && hello_sent_ && e.seq == hello_token_) {
+    if (e.code == ErrorCode::kUnsupportedVersion) {
+      Fail("protocol version mismatch: device speaks " + std::to_string(e.detail) + ", host " +
+           std::to_string(protocol::kProtocolVersion));
+      return;
+    }
+    what = "hello";
+  } else if (const size_t index = static_cast<uint16_t>(e.seq - base_seq_); index < sent_) {
+    what = Describe(index);
+    type = queue_[index].type;
+  } else if (status_outstanding_ && e.seq == status_token_) {
+    what = "status query";
+  } else if (stop_sent_ && e.seq == stop_token_) {
+    what = "stop";
+  } else {
+    what = "an unknown frame (seq " + std::to_string(e.seq) + ")";
+  }
+  std::string message = "device refused " + what + ": " + protocol::ErrorName(e.code);
+  if (e.code == ErrorCode::kBadField || e.code == ErrorCode::kBadLength) {
+    message += ", field " + std::to_string(e.detail) + " (" + FieldName(type, e.detail) + ")";
+  } else if (e.code == ErrorCode::kPlannerRefused) {
+    message += ": " + std::string(StatusMessage(static_cast<Status>(e.detail)));
+  } else if (e.detail != 0) {
+    message += " (detail " + std::to_string(e.detail) + ")";
+  }
+  Fail(message);
+}
+
+std::string HostLink::Describe(size_t index) const {
+  const Pending& p = queue_[index];
+  const std::string seq = "seq " + std::to_string(SeqOf(index));
+  if (p.label.empty()) {
+    return std::string(TypeName(p.type)) + " " + seq;
+  }
+  return p.label + " [" + TypeName(p.type) + ", " + seq + "]";
+}
+
+void HostLink::Fail(std::string message) {
+  if (state_ == State::kFailed) {
+    return;
+  }
+  state_ = State::kFailed;
+  error_ = std::move(message);
+}
+
+bool HostLink::Timeout() {
+  ++stats_.timeouts;
+  if (++retries_ > options_.max_retries) {
+    std::string waiting = "an answer";
+    if (state_ == State::kHandshake) {
+      waiting = "the hello reply";
+    } else if (next_send_ > 0 && !queue_.empty()) {
+      waiting = "the acknowledgement of " + Describe(0);
+    } else if (status_outstanding_) {
+      waiting = "a status report";
+    } else if (stop_requested_) {
+      waiting = "the acknowledgement of stop";
+    }
+    Fail("no answer from the device after " + std::to_string(options_.max_retries) +
+         " retries (waiting for " + waiting + ")");
+    return true;
+  }
+  return false;
+}
+
+void HostLink::Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out) {
+  out->insert(out->end(), frame, frame + size);
+  ++stats_.frames_sent;
+  stats_.bytes_sent += size;
+}
+
+void HostLink::SendHello(uint64_t now_us, std::vector<uint8_t>* out) {
+  hello_token_ = next_token_++;
+  const bool fresh = !session_started_ && options_.new_session;
+  const protocol::Hello hello{protocol::kProtocolVersion,
+                              fresh ? protocol::kHelloFlagNewSession : uint8_t{0}};
+  std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+  Send(frame.data(), protocol::EncodeHello(hello_token_, hello, frame.data(), frame.size()), out);
+  hello_sent_ = true;
+  hello_sent_us_ = now_us;
+  ++stats_.hellos_sent;
+}
+
+void HostLink::SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out) {
+  status_token_ = next_token_++;
+  std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+  Send(frame.data(), protocol::EncodeStatusQuery(status_token_, frame.data(), frame.size()), out);
+  status_outstanding_ = true;
+  status_sent_us_ = now_us;
+  ++stats_.status_queries;
+}
+
+uint64_t HostLink::RetransmitTimerStart() const {
+  // The later of the oldest frame's last transmission and the last
+  // acknowledgement that released something (RFC 6298, 5.3): on a slow line
+  // a frame may wait in the port's buffer longer than the timeout while ACKs
+  // for the frames before it keep arriving.
+  return std::max(queue_.front().last_sent_us, progress_us_);
+}
+
+size_t HostLink::SendLimit() const {
+  return std::min<size_t>({queue_.size(), options_.window, credits_});
+}
+
+void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
+  const uint64_t rto = options_.retransmit_timeout_us;
+  if (state_ == State::kFailed) {
+    return;
+  }
+  if (state_ == State::kHandshake) {
+    const bool resend = hello_sent_ && now_us - hello_sent_us_ >= rto;
+    if (!hello_sent_ || (resend && !Timeout())) {
+      SendHello(now_us, out);
+    }
+    return;
+  }
+  if (stop_requested_) {
+    if (!stop_acked_ && (!stop_sent_ || now_us - stop_sent_us_ >= rto)) {
+      if (stop_sent_ && Timeout()) {
+        return;
+      }
+      stop_token_ = next_token_++;
+      std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+      Send(frame.data(), protocol::EncodeStop(stop_token_, frame.data(), frame.size()), out);
+      stop_sent_ = true;
+      stop_sent_us_ = now_us;
+    }
+    return;  // nothing else after a stop
+  }
+  // Retransmit timeout: go back to the oldest unacknowledged frame.
+  if (next_send_ > 0 && now_us - RetransmitTimerStart() >= rto) {
+    if (Timeout()) {
+      return;
+    }
+    next_send_ = 0;
+  }
+  std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+  for (const size_t limit = SendLimit(); next_send_ < limit; ++next_send_) {
+    Pending& p = queue_[next_send_];
+    Send(frame.data(),
+         protocol::EncodeFrame(p.type, SeqOf(next_send_), p.body.data(), p.body.size(),
+                               frame.data(), frame.size()),
+         out);
+    p.last_sent_us = now_us;
+    if (next_send_ < sent_) {
+      ++stats_.retransmitted;
+    } else {
+      ++stats_.commands_sent;
+      sent_ = next_send_ + 1;
+    }
+  }
+  // Nothing in flight (all acknowledged, or waiting for credit): ask.
+  if (next_send_ == 0) {
+    if (status_outstanding_) {
+      if (now_us - status_sent_us_ >= rto && !Timeout()) {
+        SendStatusQuery(now_us, out);
+      }
+    } else if (!Finished() && (stats_.status_queries == 0 ||
+                               now_us - status_sent_us_ >= options_.status_interval_us)) {
+      SendStatusQuery(now_us, out);
+    }
+  }
+}
+
+uint64_t HostLink::NextPollUs(uint64_t now_us) const {
+  constexpr uint64_t kNever = std::numeric_limits<uint64_t>::max();
+  const uint64_t rto = options_.retransmit_timeout_us;
+  switch (state_) {
+    case State::kFailed:
+      return kNever;
+    case State::kHandshake:
+      return hello_sent_ ? std::max(now_us, hello_sent_us_ + rto) : now_us;
+    case State::kRunning:
+      break;
+  }
+  if (stop_requested_) {
+    if (stop_acked_) {
+      return kNever;
+    }
+    return stop_sent_ ? std::max(now_us, stop_sent_us_ + rto) : now_us;
+  }
+  if (next_send_ < SendLimit()) {
+    return now_us;
+  }
+  if (next_send_ > 0) {
+    return std::max(now_us, RetransmitTimerStart() + rto);
+  }
+  if (status_outstanding_) {
+    return std::max(now_us, status_sent_us_ + rto);
+  }
+  if (Finished()) {
+    return kNever;
+  }
+  return stats_.status_queries == 0
+             ? now_us
+             : std::max(now_us, status_sent_us_ + options_.status_interval_us);
+}
+
+void HostLink::Resume() {
+  if (state_ == State::kFailed) {
+    return;
+  }
+  state_ = State::kHandshake;
+  hello_sent_ = false;
+  status_outstanding_ = false;
+  stop_sent_ = false;
+  retries_ = 0;
+  decoder_.Reset();
+}
+
+void HostLink::RequestStop() { stop_requested_ = true; }
+
+bool HostLink::Finished() const {
+  if (!AllAcknowledged() || !status_ || status_->next_seq != base_seq_) {
+    return false;
+  }
+  if (status_->state != protocol::DeviceState::kIdle || status_->queued != 0) {
+    return false;
+  }
+  // The executed count is since the device's session began: known only
+  // when this host began it.
+  return !options_.new_session || status_->executed == static_cast<uint32_t>(enqueued_);
+}
+
+}  // namespace fdsurf::host

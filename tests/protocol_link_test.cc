@@ -1,0 +1,830 @@
+// The device link (DeviceLink) and the host's reliable sender (HostLink),
+// end to end through the fault-injection link in virtual time.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "fdsurf/host/link.h"
+#include "fdsurf/protocol/codec.h"
+#include "fdsurf/protocol/device_link.h"
+#include "fdsurf/sim/fault_link.h"
+
+namespace fdsurf::protocol {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+using host::HostLink;
+using host::HostLinkOptions;
+using sim::FaultLink;
+using sim::FaultRates;
+using sim::Pipe;
+
+// A device queue stand-in: accepts into a bounded queue, executes one queued
+// command every `drain_every` ticks, can refuse a chosen command.
+struct FakeSink {
+  uint8_t capacity = 8;
+  std::deque<Command> queue;
+  std::vector<Command> accepted;  // every Accept that returned kNone, in order
+  uint32_t executed = 0;
+  int resets = 0;
+  int stops = 0;
+  int accept_calls_without_credit = 0;
+  // Refuse the command accepted as number refuse_at (0-based), if set.
+  int64_t refuse_at = -1;
+  ErrorCode refuse_code = ErrorCode::kBadField;
+  uint8_t refuse_detail = 0;
+
+  ErrorCode Accept(const Command& command, uint8_t* detail) {
+    if (Credits() == 0) {
+      ++accept_calls_without_credit;
+    }
+    if (static_cast<int64_t>(accepted.size()) == refuse_at) {
+      *detail = refuse_detail;
+      return refuse_code;
+    }
+    accepted.push_back(command);
+    queue.push_back(command);
+    return ErrorCode::kNone;
+  }
+  uint8_t Credits() const { return static_cast<uint8_t>(capacity - queue.size()); }
+  uint8_t QueueCapacity() const { return capacity; }
+  uint32_t TickHz() const { return 40000; }
+  uint8_t MaxAxes() const { return 3; }
+  void FillStatus(StatusReport* report) const {
+    *report = StatusReport{};
+    report->state = queue.empty() ? DeviceState::kIdle : DeviceState::kRunning;
+    report->error = ErrorCode::kNone;
+    report->queued = static_cast<uint8_t>(queue.size());
+    report->credits = Credits();
+    report->executed = executed;
+  }
+  void Stop() {
+    ++stops;
+    queue.clear();
+  }
+  void Reset() {
+    ++resets;
+    queue.clear();
+    executed = 0;
+  }
+  void Execute() {
+    if (!queue.empty()) {
+      queue.pop_front();
+      ++executed;
+    }
+  }
+};
+
+using Device = DeviceLink<FakeSink>;
+
+Bytes BodyOf(const Command& command) {
+  Bytes body(kMaxBodyBytes);
+  body.resize(EncodeCommandBody(command, body.data(), body.size()));
+  return body;
+}
+
+// The i-th command of a test job: a mix of every type, bodies depending on i
+// so that order and content can be checked.
+Command JobCommand(uint32_t i, bool small_only = false) {
+  Command c;
+  c.seq = 0;
+  if (i == 0) {
+    c.type = MessageType::kConfig;
+    c.body.config =
+        MachineConfig{2, {80000, 80000, 0}, {kMaxTravelSteps, kMaxTravelSteps, 0}, 4000, 20000, 0};
+    return c;
+  }
+  const uint32_t kind = small_only ? i % 2 : i % 7;
+  if (kind == 0 || kind == 4) {
+    c.type = MessageType::kMove;
+    c.body.move = MoveCommand{{static_cast<int32_t>(i), static_cast<int32_t>(i * 7 % 1000), 0}};
+  } else if (kind == 1) {
+    c.type = MessageType::kPen;
+    c.body.pen.down = (i / 7) % 2 == 1;
+  } else if (kind == 2 || kind == 5) {
+    c.type = MessageType::kCurve;
+    c.body.curve = CurveCommand{};
+    c.body.curve.basis = Basis::kBezier;
+    c.body.curve.dims = 2;
+    c.body.curve.tolerance_q8 = 100 + i;
+    for (int a = 0; a < 2; ++a) {
+      for (int k = 0; k < 4; ++k) {
+        c.body.curve.geometry[a].g[k] =
+            GeometryFixed::FromRaw(static_cast<int64_t>(i) * 65536 + a * 100 + k);
+      }
+    }
+  } else {
+    c.type = MessageType::kPatch;
+    c.body.patch = PatchCommand{};
+    c.body.patch.basis = Basis::kBSpline;
+    c.body.patch.dims = 2;
+    c.body.patch.lines_s = 8;
+    c.body.patch.lines_t = 8;
+    c.body.patch.tolerance_q8 = 13;
+    for (int a = 0; a < 2; ++a) {
+      for (int k = 0; k < 16; ++k) {
+        c.body.patch.geometry[a].g[k / 4][k % 4] = GeometryFixed::FromRaw(
+            (int64_t{1} << 29) - static_cast<int64_t>(i) * 977 * (k + 1) + a);
+      }
+    }
+  }
+  return c;
+}
+
+// Host and device connected by two faulty pipes, stepped in virtual time.
+struct Harness {
+  Harness(HostLinkOptions options, FaultRates rates, uint64_t seed, uint64_t latency_us = 300)
+      : host(options),
+        device(&sink),
+        to_device(rates, seed * 2 + 1),
+        to_host(rates, seed * 2 + 2),
+        pipe_to_device(latency_us),
+        pipe_to_host(latency_us) {}
+
+  // One tick of `step_us`: host sends, bytes travel, the device answers and
+  // executes (one command every drain_every ticks).
+  void Step() {
+    Bytes out;
+    host.Poll(now, &out);
+    Bytes faulted;
+    to_device.Process(out.data(), out.size(), &faulted);
+    if (bytes_per_step == 0) {
+      pipe_to_device.Write(faulted.data(), faulted.size(), now);
+    } else {  // a slow serial line: the rest waits in the port's buffer
+      backlog.insert(backlog.end(), faulted.begin(), faulted.end());
+      const size_t n = std::min<size_t>(backlog.size(), bytes_per_step);
+      pipe_to_device.Write(backlog.data(), n, now);
+      backlog.erase(backlog.begin(), backlog.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+    uint8_t buffer[4096];
+    for (size_t n; (n = pipe_to_device.Read(buffer, sizeof buffer, now)) > 0;) {
+      for (size_t k = 0; k < n; ++k) {
+        device.OnByte(buffer[k]);
+      }
+    }
+    if (++ticks % drain_every == 0) {
+      sink.Execute();
+    }
+    for (size_t n; (n = device.ReadOutput(buffer, sizeof buffer)) > 0;) {
+      faulted.clear();
+      to_host.Process(buffer, n, &faulted);
+      pipe_to_host.Write(faulted.data(), faulted.size(), now);
+    }
+    for (size_t n; (n = pipe_to_host.Read(buffer, sizeof buffer, now)) > 0;) {
+      host.OnBytes(buffer, n, now);
+    }
+    now += step_us;
+  }
+
+  // Runs until finished, failed or `limit_us` of virtual time.
+  void Run(uint64_t limit_us) {
+    while (!host.Finished() && !host.Failed() && now < limit_us) {
+      Step();
+    }
+  }
+
+  FakeSink sink;
+  HostLink host;
+  Device device;
+  FaultLink to_device;
+  FaultLink to_host;
+  Pipe pipe_to_device;
+  Pipe pipe_to_host;
+  uint64_t now = 0;
+  uint64_t ticks = 0;
+  uint64_t step_us = 100;
+  uint64_t drain_every = 1;
+  size_t bytes_per_step = 0;  // host → device bandwidth per step; 0: unlimited
+  Bytes backlog;
+};
+
+void EnqueueJob(HostLink* host, uint32_t count, bool small_only = false) {
+  for (uint32_t i = 0; i < count; ++i) {
+    ASSERT_TRUE(host->Enqueue(JobCommand(i, small_only), "command " + std::to_string(i)).ok());
+  }
+}
+
+// Every command accepted exactly once, in order, with its content intact.
+void ExpectExactlyOnceInOrder(const FakeSink& sink, uint32_t count, bool small_only = false) {
+  ASSERT_EQ(sink.accepted.size(), count);
+  for (uint32_t i = 0; i < count; ++i) {
+    const Command expected = JobCommand(i, small_only);
+    ASSERT_EQ(sink.accepted[i].type, expected.type) << i;
+    ASSERT_EQ(sink.accepted[i].seq, static_cast<uint16_t>(i)) << i;
+    ASSERT_EQ(BodyOf(sink.accepted[i]), BodyOf(expected)) << i;
+  }
+}
+
+// ---------------------------------------------------------------- DeviceLink alone
+
+struct DirectDevice {
+  FakeSink sink;
+  Device device{&sink};
+
+  std::vector<Reply> Send(const Bytes& wire) {
+    for (uint8_t b : wire) {
+      device.OnByte(b);
+    }
+    Bytes out(4096);
+    out.resize(device.ReadOutput(out.data(), out.size()));
+    std::vector<Reply> replies;
+    FrameDecoderBuffer<> decoder;
+    for (uint8_t b : out) {
+      if (decoder.OnByte(b)) {
+        Reply r;
+        EXPECT_TRUE(DecodeReply(decoder.frame(), &r).ok());
+        replies.push_back(r);
+      }
+    }
+    return replies;
+  }
+  Reply SendOne(const Bytes& wire) {
+    const std::vector<Reply> replies = Send(wire);
+    EXPECT_EQ(replies.size(), 1u);
+    return replies.empty() ? Reply{} : replies[0];
+  }
+};
+
+Bytes WireOf(Command command, uint16_t seq) {
+  command.seq = seq;
+  Bytes out(kMaxEncodedFrameBytes);
+  out.resize(EncodeCommand(command, out.data(), out.size()));
+  return out;
+}
+
+Bytes HelloWire(uint16_t token, uint8_t flags, uint8_t version = kProtocolVersion) {
+  Bytes out(kMaxEncodedFrameBytes);
+  out.resize(EncodeHello(token, Hello{version, flags}, out.data(), out.size()));
+  return out;
+}
+
+TEST(DeviceLink, AcceptsInOrderAcksDuplicatesNaksGaps) {
+  DirectDevice d;
+  Reply r = d.SendOne(HelloWire(42, kHelloFlagNewSession));
+  ASSERT_EQ(r.type, MessageType::kHelloReply);
+  EXPECT_EQ(r.seq, 42);
+  EXPECT_EQ(r.body.hello.next_seq, 0);
+  EXPECT_EQ(r.body.hello.credits, 8);
+  EXPECT_EQ(r.body.hello.queue_capacity, 8);
+  EXPECT_EQ(r.body.hello.tick_hz, 40000u);
+  EXPECT_EQ(r.body.hello.max_lines, kMaxLines);
+  EXPECT_EQ(d.sink.resets, 1);
+
+  r = d.SendOne(WireOf(JobCommand(0), 0));
+  ASSERT_EQ(r.type, MessageType::kAck);
+  EXPECT_EQ(r.seq, 0);
+  EXPECT_EQ(r.body.ack.next_seq, 1);
+  EXPECT_EQ(r.body.ack.credits, 7);
+
+  r = d.SendOne(WireOf(JobCommand(0), 0));  // duplicate: acked, not executed
+  ASSERT_EQ(r.type, MessageType::kAck);
+  EXPECT_EQ(r.body.ack.next_seq, 1);
+  EXPECT_EQ(d.sink.accepted.size(), 1u);
+  EXPECT_EQ(d.device.stats().duplicates, 1u);
+
+  r = d.SendOne(WireOf(JobCommand(2), 2));  // gap: NAK naming the expected seq
+  ASSERT_EQ(r.type, MessageType::kNak);
+  EXPECT_EQ(r.seq, 2);
+  EXPECT_EQ(r.body.nak.next_seq, 1);
+  EXPECT_EQ(r.body.nak.reason, ErrorCode::kOutOfOrder);
+  EXPECT_EQ(d.sink.accepted.size(), 1u);
+
+  // 0x8000 behind is a duplicate; 0x7FFF ahead is out of order.
+  EXPECT_EQ(d.SendOne(WireOf(JobCommand(1), static_cast<uint16_t>(1 - 0x8000))).type,
+            MessageType::kAck);
+  EXPECT_EQ(d.SendOne(WireOf(JobCommand(1), 0x8000)).type, MessageType::kNak);
+  EXPECT_EQ(d.device.next_seq(), 1);
+}
+
+TEST(DeviceLink, InvalidCommandIsRefusedWithFieldAndDoesNotAdvance) {
+  DirectDevice d;
+  d.SendOne(HelloWire(1, kHelloFlagNewSession));
+  Command bad = JobCommand(0);
+  bad.body.config.accel = 0;
+  Reply r = d.SendOne(WireOf(bad, 0));
+  ASSERT_EQ(r.type, MessageType::kError);
+  EXPECT_EQ(r.body.error.seq, 0);
+  EXPECT_EQ(r.body.error.code, ErrorCode::kBadField);
+  EXPECT_EQ(r.body.error.detail, kConfigFieldAccel);
+  EXPECT_EQ(d.device.next_seq(), 0);
+  EXPECT_TRUE(d.sink.accepted.empty());
+  // The sink's own refusal: code and detail pass through.
+  d.sink.refuse_at = 0;
+  d.sink.refuse_code = ErrorCode::kPlannerRefused;
+  d.sink.refuse_detail = 4;
+  r = d.SendOne(WireOf(JobCommand(0), 0));
+  ASSERT_EQ(r.type, MessageType::kError);
+  EXPECT_EQ(r.body.error.code, ErrorCode::kPlannerRefused);
+  EXPECT_EQ(r.body.error.detail, 4);
+  EXPECT_EQ(d.device.next_seq(), 0);
+  // An unknown sequenced type at next_seq.
+  Bytes wire(kMaxEncodedFrameBytes);
+  wire.resize(EncodeFrame(static_cast<MessageType>(0x1F), 0, nullptr, 0, wire.data(), wire.size()));
+  r = d.SendOne(wire);
+  ASSERT_EQ(r.type, MessageType::kError);
+  EXPECT_EQ(r.body.error.code, ErrorCode::kUnknownType);
+  // A host→device type the device does not take.
+  wire.assign(kMaxEncodedFrameBytes, 0);
+  wire.resize(EncodeAck(0, Ack{0, 0}, wire.data(), wire.size()));
+  EXPECT_EQ(d.SendOne(wire).body.error.code, ErrorCode::kUnknownType);
+}
+
+TEST(DeviceLink, QueueFullWithoutCreditAndStatusStop) {
+  DirectDevice d;
+  d.sink.capacity = 2;
+  d.SendOne(HelloWire(1, kHelloFlagNewSession));
+  EXPECT_EQ(d.SendOne(WireOf(JobCommand(0), 0)).body.ack.credits, 1);
+  EXPECT_EQ(d.SendOne(WireOf(JobCommand(1), 1)).body.ack.credits, 0);
+  Reply r = d.SendOne(WireOf(JobCommand(2), 2));
+  ASSERT_EQ(r.type, MessageType::kNak);
+  EXPECT_EQ(r.body.nak.reason, ErrorCode::kQueueFull);
+  EXPECT_EQ(r.body.nak.next_seq, 2);
+  EXPECT_EQ(d.sink.accept_calls_without_credit, 0);
+
+  Bytes wire(kMaxEncodedFrameBytes);
+  wire.resize(EncodeStatusQuery(0x5151, wire.data(), wire.size()));
+  r = d.SendOne(wire);
+  ASSERT_EQ(r.type, MessageType::kStatusReport);
+  EXPECT_EQ(r.seq, 0x5151);
+  EXPECT_EQ(r.body.status.next_seq, 2);
+  EXPECT_EQ(r.body.status.queued, 2);
+  EXPECT_EQ(r.body.status.state, DeviceState::kRunning);
+
+  wire.assign(kMaxEncodedFrameBytes, 0);
+  wire.resize(EncodeStop(0x5252, wire.data(), wire.size()));
+  r = d.SendOne(wire);
+  ASSERT_EQ(r.type, MessageType::kAck);
+  EXPECT_EQ(r.seq, 0x5252);
+  EXPECT_EQ(r.body.ack.credits, 2);
+  EXPECT_EQ(d.sink.stops, 1);
+}
+
+TEST(DeviceLink, HelloResumeKeepsStateAndVersionMismatchIsRefused) {
+  DirectDevice d;
+  d.SendOne(HelloWire(1, kHelloFlagNewSession));
+  d.SendOne(WireOf(JobCommand(0), 0));
+  d.SendOne(WireOf(JobCommand(1), 1));
+  Reply r = d.SendOne(HelloWire(2, 0));  // resume
+  EXPECT_EQ(r.body.hello.next_seq, 2);
+  EXPECT_EQ(d.sink.resets, 1);
+  r = d.SendOne(HelloWire(3, 0, kProtocolVersion + 1));
+  ASSERT_EQ(r.type, MessageType::kError);
+  EXPECT_EQ(r.seq, 3);
+  EXPECT_EQ(r.body.error.code, ErrorCode::kUnsupportedVersion);
+  EXPECT_EQ(r.body.error.detail, kProtocolVersion);
+  r = d.SendOne(HelloWire(4, 0x80));
+  EXPECT_EQ(r.body.error.code, ErrorCode::kBadField);
+  EXPECT_EQ(r.body.error.detail, kHelloFieldFlags);
+  r = d.SendOne(HelloWire(5, kHelloFlagNewSession));
+  EXPECT_EQ(r.body.hello.next_seq, 0);
+  EXPECT_EQ(d.sink.resets, 2);
+  EXPECT_EQ(d.device.next_seq(), 0);
+}
+
+TEST(DeviceLink, RepliesThatDoNotFitAreDroppedAndCounted) {
+  FakeSink sink;
+  DeviceLink<FakeSink, 64> device(&sink);
+  const Bytes hello = HelloWire(1, kHelloFlagNewSession);
+  for (int k = 0; k < 5; ++k) {
+    for (uint8_t b : hello) {
+      device.OnByte(b);
+    }
+  }
+  EXPECT_GT(device.stats().replies_dropped, 0u);
+  EXPECT_LE(device.OutputPending(), 64u);
+  // What is there is whole replies: they all decode.
+  Bytes out(64);
+  out.resize(device.ReadOutput(out.data(), out.size()));
+  FrameDecoderBuffer<> decoder;
+  int replies = 0;
+  for (uint8_t b : out) {
+    replies += decoder.OnByte(b) ? 1 : 0;
+  }
+  EXPECT_GE(replies, 1);
+  EXPECT_EQ(decoder.stats().crc_errors + decoder.stats().cobs_errors, 0u);
+  EXPECT_EQ(static_cast<uint32_t>(replies) + device.stats().replies_dropped, 5u);
+}
+
+// Random bytes, and mutated valid frames, into a DeviceLink: no crash, no
+// acceptance out of order (run under the sanitizer build too).
+TEST(DeviceLink, ByteFuzz) {
+  std::mt19937_64 rng(31);
+  FakeSink sink;
+  sink.capacity = 255;
+  Device device(&sink);
+  Bytes out(4096);
+  for (int round = 0; round < 20000; ++round) {
+    Bytes wire = round % 3 == 0
+                     ? HelloWire(static_cast<uint16_t>(round), static_cast<uint8_t>(rng() % 2))
+                     : WireOf(JobCommand(static_cast<uint32_t>(rng() % 50)),
+                              static_cast<uint16_t>(rng() % 8));
+    if (rng() % 2 == 0) {
+      wire[rng() % wire.size()] ^= static_cast<uint8_t>(1u << (rng() % 8));
+    }
+    for (uint64_t k = rng() % 40; k > 0; --k) {
+      wire.push_back(static_cast<uint8_t>(rng() % 3 == 0 ? 0 : rng()));
+    }
+    for (uint8_t b : wire) {
+      device.OnByte(b);
+    }
+    while (device.ReadOutput(out.data(), out.size()) > 0) {
+    }
+    if (sink.queue.size() > 200) {
+      sink.queue.clear();
+    }
+  }
+  for (size_t i = 0; i < sink.accepted.size(); ++i) {
+    // Seqs restart at 0 on every new-session HELLO; within a session they
+    // are consecutive.
+    if (i > 0 && sink.accepted[i].seq != 0) {
+      ASSERT_EQ(sink.accepted[i].seq, static_cast<uint16_t>(sink.accepted[i - 1].seq + 1));
+    }
+  }
+  EXPECT_GT(sink.accepted.size(), 100u);
+}
+
+// ---------------------------------------------------------------- end to end
+
+HostLinkOptions TestOptions() {
+  HostLinkOptions options;
+  options.window = 16;
+  options.retransmit_timeout_us = 20'000;
+  options.max_retries = 60;
+  options.status_interval_us = 5'000;
+  return options;
+}
+
+TEST(HostLink, DeliversAJobWithoutFaults) {
+  Harness h(TestOptions(), FaultRates{}, 1);
+  EnqueueJob(&h.host, 500);
+  h.Run(60'000'000);
+  ASSERT_TRUE(h.host.Finished()) << h.host.error();
+  ExpectExactlyOnceInOrder(h.sink, 500);
+  EXPECT_EQ(h.host.stats().retransmitted, 0u);
+  EXPECT_EQ(h.host.stats().commands_sent, 500u);
+  EXPECT_EQ(h.host.stats().timeouts, 0u);
+  EXPECT_EQ(h.device.stats().duplicates, 0u);
+  EXPECT_EQ(h.host.status()->executed, 500u);
+  EXPECT_EQ(h.sink.resets, 1);
+}
+
+struct FaultCase {
+  double rate;
+  uint64_t seed;
+};
+
+class HostLinkFaults : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(HostLinkFaults, ExactlyOnceInOrderThroughFaults) {
+  const FaultCase fc = GetParam();
+  const uint32_t count = 400;
+  Harness h(TestOptions(), FaultRates::All(fc.rate), fc.seed);
+  h.drain_every = 3;
+  EnqueueJob(&h.host, count);
+  h.Run(600'000'000);  // bounded virtual time: a deadlock fails here
+  ASSERT_TRUE(h.host.Finished()) << "rate " << fc.rate << " seed " << fc.seed << ": "
+                                 << (h.host.Failed() ? h.host.error() : "not finished in time");
+  ExpectExactlyOnceInOrder(h.sink, count);
+  EXPECT_EQ(h.sink.accept_calls_without_credit, 0);
+  const host::HostLinkStats& s = h.host.stats();
+  if (fc.rate == 0) {
+    EXPECT_EQ(s.retransmitted, 0u);
+  } else {
+    EXPECT_GT(h.to_device.stats().dropped + h.to_host.stats().dropped, 0u);
+  }
+  RecordProperty("retransmitted", std::to_string(s.retransmitted));
+  std::printf(
+      "rate %.2f seed %llu: %llu commands, %llu retransmitted, %llu timeouts, %llu NAKs, "
+      "%llu duplicate ACKs, device duplicates %u, out of order %u, virtual time %.3f s\n",
+      fc.rate, static_cast<unsigned long long>(fc.seed),
+      static_cast<unsigned long long>(s.commands_sent),
+      static_cast<unsigned long long>(s.retransmitted), static_cast<unsigned long long>(s.timeouts),
+      static_cast<unsigned long long>(s.naks), static_cast<unsigned long long>(s.duplicate_acks),
+      h.device.stats().duplicates, h.device.stats().out_of_order, static_cast<double>(h.now) / 1e6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Rates, HostLinkFaults,
+                         ::testing::Values(FaultCase{0.0, 1}, FaultCase{0.01, 1},
+                                           FaultCase{0.01, 2}, FaultCase{0.01, 3},
+                                           FaultCase{0.05, 1}, FaultCase{0.05, 2},
+                                           FaultCase{0.05, 3}, FaultCase{0.2, 1}, FaultCase{0.2, 2},
+                                           FaultCase{0.2, 3}, FaultCase{0.2, 4}),
+                         [](const ::testing::TestParamInfo<FaultCase>& info) {
+                           return "Rate" + std::to_string(static_cast<int>(info.param.rate * 100)) +
+                                  "Seed" + std::to_string(info.param.seed);
+                         });
+
+TEST(HostLink, CreditsRespectedWithSlowSink) {
+  // Queue of 3, window 16, one command executed every 5 ms: the host must
+  // never overrun (no kQueueFull NAK, no Accept without credit).
+  for (double rate : {0.0, 0.05}) {
+    Harness h(TestOptions(), FaultRates::All(rate), 9);
+    h.sink.capacity = 3;
+    h.drain_every = 50;
+    EnqueueJob(&h.host, 120);
+    h.Run(120'000'000);
+    ASSERT_TRUE(h.host.Finished()) << h.host.error();
+    ExpectExactlyOnceInOrder(h.sink, 120);
+    EXPECT_EQ(h.device.stats().queue_full, 0u) << rate;
+    EXPECT_EQ(h.host.stats().queue_full_naks, 0u) << rate;
+    EXPECT_EQ(h.sink.accept_calls_without_credit, 0);
+    EXPECT_GT(h.host.stats().status_queries, 10u) << "credit waits are polled";
+  }
+}
+
+TEST(HostLink, ResumesAfterADisconnect) {
+  Harness h(TestOptions(), FaultRates{}, 5);
+  h.drain_every = 2;
+  EnqueueJob(&h.host, 600);
+  while (h.sink.accepted.size() < 250) {
+    h.Step();
+  }
+  // The cable is out for 300 ms: everything in both directions is lost.
+  h.to_device.set_rates(FaultRates{1, 0, 0, 0, 0});
+  h.to_host.set_rates(FaultRates{1, 0, 0, 0, 0});
+  const uint64_t back = h.now + 300'000;
+  while (h.now < back) {
+    h.Step();
+  }
+  ASSERT_FALSE(h.host.Failed()) << h.host.error();
+  EXPECT_GT(h.host.stats().timeouts, 0u);
+  h.to_device.set_rates(FaultRates{});
+  h.to_host.set_rates(FaultRates{});
+  h.host.Resume();
+  EXPECT_FALSE(h.host.Connected());
+  h.Run(h.now + 60'000'000);
+  ASSERT_TRUE(h.host.Finished()) << h.host.error();
+  ExpectExactlyOnceInOrder(h.sink, 600);
+  EXPECT_EQ(h.sink.resets, 1) << "a resume HELLO resets nothing";
+  EXPECT_EQ(h.host.stats().hellos_sent, 2u);
+}
+
+TEST(HostLink, ResumeWithADeviceThatLostTheSessionFails) {
+  Harness h(TestOptions(), FaultRates{}, 6);
+  EnqueueJob(&h.host, 100);
+  while (h.sink.accepted.size() < 50) {
+    h.Step();
+  }
+  // The device rebooted: another host (or a reset) started a new session.
+  for (uint8_t b : HelloWire(999, kHelloFlagNewSession)) {
+    h.device.OnByte(b);
+  }
+  Bytes discard(4096);
+  while (h.device.ReadOutput(discard.data(), discard.size()) > 0) {
+  }
+  h.host.Resume();
+  // Run until the handshake settles; fresh device expects 0, host is past it.
+  for (int k = 0; k < 1000 && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  ASSERT_TRUE(h.host.Failed());
+  EXPECT_NE(h.host.error().find("lost the session"), std::string::npos) << h.host.error();
+}
+
+TEST(HostLink, NoAnswerFailsAfterMaxRetries) {
+  HostLinkOptions options = TestOptions();
+  options.max_retries = 5;
+  Harness h(options, FaultRates{1, 0, 0, 0, 0}, 7);
+  EnqueueJob(&h.host, 10);
+  h.Run(10'000'000);
+  ASSERT_TRUE(h.host.Failed());
+  EXPECT_NE(h.host.error().find("no answer from the device after 5 retries"), std::string::npos)
+      << h.host.error();
+  EXPECT_EQ(h.host.stats().hellos_sent, 6u);
+}
+
+TEST(HostLink, DeviceErrorNamesTheCommandAndField) {
+  Harness h(TestOptions(), FaultRates::All(0.05), 8);
+  h.sink.refuse_at = 0;  // the config
+  h.sink.refuse_code = ErrorCode::kBadField;
+  h.sink.refuse_detail = kConfigFieldMaxRate;  // e.g. above the device's tick rate
+  Command config = JobCommand(0);
+  ASSERT_TRUE(h.host.Enqueue(config, "config (plotter.toml:3)").ok());
+  for (uint32_t i = 1; i < 20; ++i) {
+    ASSERT_TRUE(h.host.Enqueue(JobCommand(i)).ok());
+  }
+  h.Run(60'000'000);
+  ASSERT_TRUE(h.host.Failed());
+  EXPECT_EQ(
+      h.host.error(),
+      "device refused config (plotter.toml:3) [config, seq 0]: bad field, field 7 (max_rate)");
+  EXPECT_TRUE(h.sink.accepted.empty());
+}
+
+TEST(HostLink, PlannerRefusalNamesTheStatus) {
+  Harness h(TestOptions(), FaultRates{}, 8);
+  h.sink.refuse_at = 6;  // JobCommand(6) is a patch
+  h.sink.refuse_code = ErrorCode::kPlannerRefused;
+  h.sink.refuse_detail = static_cast<uint8_t>(Status::kPrecisionUnreachable);
+  for (uint32_t i = 0; i < 10; ++i) {
+    ASSERT_TRUE(h.host.Enqueue(JobCommand(i), "patch 3 (teapot.bpt:12)").ok());
+  }
+  h.Run(60'000'000);
+  ASSERT_TRUE(h.host.Failed());
+  EXPECT_EQ(h.host.error(),
+            "device refused patch 3 (teapot.bpt:12) [patch, seq 6]: planner refused: precision "
+            "unreachable");
+  EXPECT_EQ(h.sink.accepted.size(), 6u);
+}
+
+TEST(HostLink, EnqueueValidatesLikeTheDevice) {
+  HostLink link;
+  Command bad = JobCommand(3);  // a curve
+  bad.body.curve.dims = 7;
+  const DecodeResult r = link.Enqueue(bad);
+  EXPECT_EQ(r.code, ErrorCode::kBadField);
+  EXPECT_EQ(r.field, kCurveFieldDims);
+  EXPECT_EQ(link.enqueued(), 0u);
+}
+
+TEST(HostLink, VersionMismatchFails) {
+  HostLink link(TestOptions());
+  Bytes out;
+  link.Poll(0, &out);
+  // Decode the HELLO's token and answer as a device of another version.
+  FrameDecoderBuffer<> decoder;
+  uint16_t token = 0;
+  for (uint8_t b : out) {
+    if (decoder.OnByte(b)) {
+      token = decoder.frame().seq;
+    }
+  }
+  Bytes reply(kMaxEncodedFrameBytes);
+  reply.resize(EncodeError(ErrorReply{token, ErrorCode::kUnsupportedVersion, 2}, reply.data(),
+                           reply.size()));
+  link.OnBytes(reply.data(), reply.size(), 10);
+  ASSERT_TRUE(link.Failed());
+  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 2, host 1");
+}
+
+TEST(HostLink, StopIsSentUntilAcknowledged) {
+  Harness h(TestOptions(), FaultRates::All(0.2), 12);
+  h.drain_every = 100;
+  EnqueueJob(&h.host, 200);
+  while (h.sink.accepted.size() < 20) {
+    h.Step();
+  }
+  h.host.RequestStop();
+  for (int k = 0; k < 100000 && !h.host.StopAcknowledged() && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  EXPECT_TRUE(h.host.StopAcknowledged()) << h.host.error();
+  EXPECT_GE(h.sink.stops, 1);
+  EXPECT_EQ(h.host.NextPollUs(h.now), UINT64_MAX);
+}
+
+// More than 65536 commands: the u16 sequence numbers wrap and delivery stays
+// exactly-once and in order.
+TEST(HostLink, SequenceNumbersWrapAround) {
+  HostLinkOptions options = TestOptions();
+  options.window = 32;
+  Harness h(options, FaultRates::All(0.01), 13, 100);
+  h.sink.capacity = 64;
+  const uint32_t count = 70000;
+  EnqueueJob(&h.host, count, /*small_only=*/true);
+  h.Run(3'600'000'000);
+  ASSERT_TRUE(h.host.Finished()) << h.host.error();
+  ASSERT_EQ(h.sink.accepted.size(), count);
+  for (uint32_t i = 0; i < count; ++i) {
+    ASSERT_EQ(h.sink.accepted[i].seq, static_cast<uint16_t>(i));
+    ASSERT_EQ(BodyOf(h.sink.accepted[i]), BodyOf(JobCommand(i, true))) << i;
+  }
+  EXPECT_EQ(h.device.next_seq(), static_cast<uint16_t>(count));
+  EXPECT_EQ(h.host.status()->executed, count);
+  EXPECT_GT(h.host.stats().retransmitted, 0u);
+}
+
+// Patches over a 115200-baud line: a full window takes longer to transmit
+// than the retransmit timeout. The timer restarts on every acknowledgement
+// (as TCP's does, RFC 6298 5.3), so a steady stream of ACKs never times out.
+TEST(HostLink, SlowLineCausesNoSpuriousTimeouts) {
+  HostLinkOptions options = TestOptions();
+  options.retransmit_timeout_us = 200'000;
+  Harness h(options, FaultRates{}, 30, 2'000);
+  h.step_us = 1'000;
+  h.bytes_per_step = 11;  // 11.5 kB/s
+  h.sink.capacity = 32;
+  for (uint32_t i = 0; i < 100; ++i) {
+    ASSERT_TRUE(h.host.Enqueue(JobCommand(i * 7 % 700 == 0 ? 1 : 6)).ok());  // patches
+  }
+  h.Run(600'000'000);
+  ASSERT_TRUE(h.host.Finished()) << h.host.error();
+  EXPECT_EQ(h.host.stats().timeouts, 0u);
+  EXPECT_EQ(h.host.stats().retransmitted, 0u);
+  EXPECT_GT(h.now, 1'000'000u) << "the line, not the protocol, sets the pace";
+}
+
+TEST(HostLink, NextPollUsSaysWhenThereIsWork) {
+  HostLinkOptions options = TestOptions();
+  HostLink link(options);
+  EXPECT_EQ(link.NextPollUs(5), 5u) << "the HELLO is due at once";
+  Bytes out;
+  link.Poll(5, &out);
+  EXPECT_FALSE(out.empty());
+  EXPECT_EQ(link.NextPollUs(6), 5 + options.retransmit_timeout_us);
+  out.clear();
+  link.Poll(6, &out);
+  EXPECT_TRUE(out.empty()) << "nothing before the timeout";
+}
+
+// The same job in an event-driven loop: time jumps straight to the next
+// event (host timer, byte arrival, device tick), as a simulator or a
+// poll()-based real-time loop would do. Catches a NextPollUs() that is late
+// (the loop would stall) or early-and-idle (the loop would spin).
+TEST(HostLink, EventDrivenLoopThroughFaults) {
+  for (uint64_t seed : {21u, 22u, 23u}) {
+    Harness h(TestOptions(), FaultRates::All(0.05), seed, 700);
+    const uint64_t tick_us = 250;  // the device executes one command per tick
+    uint64_t next_tick = tick_us;
+    EnqueueJob(&h.host, 300);
+    uint64_t iterations = 0;
+    int same_time = 0;
+    while (!h.host.Finished() && !h.host.Failed() && h.now < 600'000'000) {
+      h.step_us = 0;
+      h.drain_every = UINT64_MAX;
+      h.Step();
+      if (h.now >= next_tick) {
+        h.sink.Execute();
+        next_tick += tick_us;
+      }
+      uint64_t next = std::min(h.host.NextPollUs(h.now), next_tick);
+      for (const Pipe* pipe : {&h.pipe_to_device, &h.pipe_to_host}) {
+        if (pipe->next_arrival_us()) {
+          next = std::min(next, *pipe->next_arrival_us());
+        }
+      }
+      ASSERT_GE(next, h.now);
+      same_time = next == h.now ? same_time + 1 : 0;
+      ASSERT_LT(same_time, 100) << "the loop spins at t = " << h.now;
+      h.now = next;
+      ++iterations;
+    }
+    ASSERT_TRUE(h.host.Finished()) << h.host.error();
+    ExpectExactlyOnceInOrder(h.sink, 300);
+    // Far fewer iterations than a fixed 100 µs step would need.
+    EXPECT_LT(iterations, h.now / 100);
+  }
+}
+
+TEST(FaultLink, IsDeterministicAndCountsWhatItDid) {
+  Bytes stream;
+  for (int k = 0; k < 2000; ++k) {
+    const Bytes frame = WireOf(JobCommand(static_cast<uint32_t>(k % 40)), static_cast<uint16_t>(k));
+    stream.insert(stream.end(), frame.begin(), frame.end());
+  }
+  Bytes a;
+  Bytes b;
+  FaultLink la(FaultRates::All(0.1), 99);
+  FaultLink lb(FaultRates::All(0.1), 99);
+  la.Process(stream.data(), stream.size(), &a);
+  // Fed in odd pieces: the same output.
+  for (size_t at = 0; at < stream.size(); at += 37) {
+    lb.Process(stream.data() + at, std::min<size_t>(37, stream.size() - at), &b);
+  }
+  la.Flush(&a);
+  lb.Flush(&b);
+  EXPECT_EQ(a, b);
+  const sim::FaultStats& s = la.stats();
+  EXPECT_EQ(s.frames, 2000u);
+  for (uint64_t count : {s.dropped, s.corrupted, s.duplicated, s.reordered, s.truncated}) {
+    EXPECT_GT(count, 120u);
+    EXPECT_LT(count, 290u);
+  }
+  EXPECT_EQ(s.bytes_out, a.size());
+  // No faults: byte-identical.
+  Bytes clean;
+  FaultLink none(FaultRates{}, 1);
+  none.Process(stream.data(), stream.size(), &clean);
+  EXPECT_EQ(clean, stream);
+}
+
+TEST(FaultLink, ReorderSwapsWithTheNextFrame) {
+  FaultLink link(FaultRates{0, 0, 0, 1, 0}, 3);
+  const Bytes frames = {1, 0, 2, 0, 3, 0, 4, 0};
+  Bytes out;
+  link.Process(frames.data(), frames.size(), &out);
+  link.Flush(&out);
+  EXPECT_EQ(out, (Bytes{2, 0, 1, 0, 4, 0, 3, 0}));
+}
+
+TEST(Pipe, DeliversAfterLatencyInOrder) {
+  Pipe pipe(1000);
+  const Bytes data = {1, 2, 3};
+  pipe.Write(data.data(), 2, 0);
+  pipe.Write(data.data() + 2, 1, 500);
+  uint8_t buf[8];
+  EXPECT_EQ(pipe.Read(buf, sizeof buf, 999), 0u);
+  EXPECT_EQ(pipe.next_arrival_us(), 1000u);
+  EXPECT_EQ(pipe.Read(buf, sizeof buf, 1000), 2u);
+  EXPECT_EQ(pipe.Read(buf, sizeof buf, 1499), 0u);
+  EXPECT_EQ(pipe.Read(buf, sizeof buf, 1500), 1u);
+  EXPECT_EQ(buf[0], 3);
+  EXPECT_EQ(pipe.pending(), 0u);
+}
+
+}  // namespace
+}  // namespace fdsurf::protocol
