@@ -136,23 +136,7 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
                const ToolpathOptions& options, std::vector<Stroke>* strokes) {
   const Quantum& quantum = options.quantum;
   PatchGeometry1 geometry[kDims];
-  const double limit = std::ldexp(1.0, 31);
-  for (int i = 0; i < 4; ++i) {
-    for (int j = 0; j < 4; ++j) {
-      const auto out =
-          IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
-      for (int c = 0; c < kDims; ++c) {
-        const double q = quantum.ToQuanta(out[c]);
-        if (!(std::fabs(q) < limit)) {
-          throw EngineError(patch.origin + ": in output space a control value reaches " +
-                            Number(out[c]) + " " + "units, beyond ±2^31 quanta of " +
-                            quantum.Format(1) + "; use a coarser quantum or a smaller --fit");
-        }
-        geometry[c].g[i][j] = GeometryFixed::FromRaw(
-            static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
-      }
-    }
-  }
+  PatchToQuanta(patch, map, quantum, kDims, geometry);
   const double tolerance_q = options.tolerance / quantum.value();
   AdaptiveSettings settings;
   settings.mode =
@@ -277,6 +261,27 @@ void Reverse(Stroke* s) {
 
 }  // namespace
 
+void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quantum, int dims,
+                   PatchGeometry1* geometry) {
+  const double limit = std::ldexp(1.0, 31);
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const auto out =
+          IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
+      for (int c = 0; c < dims; ++c) {
+        const double q = quantum.ToQuanta(out[c]);
+        if (!(std::fabs(q) < limit)) {
+          throw EngineError(patch.origin + ": in output space a control value reaches " +
+                            Number(out[c]) + " " + "units, beyond ±2^31 quanta of " +
+                            quantum.Format(1) + "; use a coarser quantum or a smaller --fit");
+        }
+        geometry[c].g[i][j] = GeometryFixed::FromRaw(
+            static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
+      }
+    }
+  }
+}
+
 View ParseView(const std::string& text, const std::string& what) {
   View v;
   v.name = text;
@@ -329,8 +334,7 @@ std::array<double, 3> OutputMap::Apply(const Point3& p) const {
   return out;
 }
 
-Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
-                       const std::string& units, const Progress& progress) {
+Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units) {
   if (options.lines_s == 1 || options.lines_t == 1 || options.lines_s < 0 || options.lines_t < 0 ||
       options.lines_s > kMaxPatchSteps + 1 || options.lines_t > kMaxPatchSteps + 1) {
     throw InputError("--lines: each count must be 0 (family left out) or 2.." +
@@ -377,10 +381,16 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
     path.height = bh * scale + 2 * options.margin;
   }
   path.map.scale = scale;
+  path.depth = options.dims == 3 ? (box.hi[2] - box.lo[2]) * scale : 0.0;
   path.map.offset = {(path.width - bw * scale) / 2 - box.lo[0] * scale,
                      (path.height - bh * scale) / 2 - box.lo[1] * scale,
                      options.dims == 3 ? -box.hi[2] * scale : 0.0};
+  return path;
+}
 
+Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
+                       const std::string& units, const Progress& progress) {
+  Toolpath path = PlanPage(set, options, units);
   for (std::size_t p = 0; p < set.patches.size(); ++p) {
     if (options.dims == 3) {
       DrawPatch<3>(set.patches[p], p, path.map, options, &path.strokes);

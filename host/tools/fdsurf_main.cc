@@ -13,12 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "cli_options.h"
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quantum.h"
 #include "fdsurf/host/reference.h"
 #include "fdsurf/host/toolpath.h"
 #include "fdsurf/host/writers.h"
+#include "stream_command.h"
 
 namespace fdsurf::host {
 namespace {
@@ -195,49 +197,6 @@ struct PlotOptions {
   GcodeOptions gcode;
 };
 
-double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false) {
-  double value = 0;
-  std::size_t used = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value)) {
-    throw InputError(what + ": '" + text + "' is not a number");
-  }
-  if (value < 0 || (value == 0 && !allow_zero)) {
-    throw InputError(what + ": '" + text + "' must be " +
-                     (allow_zero ? "zero or more" : "greater than zero"));
-  }
-  return value;
-}
-
-std::array<int, 2> ParseLines(const std::string& text) {
-  const std::size_t x = text.find('x');
-  const auto parse = [&](std::string_view part) {
-    int value = 0;
-    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
-    if (part.empty() || ec != std::errc() || end != part.data() + part.size() || value == 1 ||
-        value < 0 || value > kMaxPatchSteps + 1) {
-      throw InputError("--lines: '" + text +
-                       "' is not U or UxV with each count 0 (left out) or 2.." +
-                       std::to_string(kMaxPatchSteps + 1));
-    }
-    return value;
-  };
-  const std::string_view all(text);
-  const int u = parse(all.substr(0, x));
-  return {u, x == std::string::npos ? u : parse(all.substr(x + 1))};
-}
-
-std::array<double, 2> ParsePage(const std::string& text) {
-  const std::size_t x = text.find('x');
-  if (x == std::string::npos) throw InputError("--fit: '" + text + "' is not WxH (like 200x150)");
-  return {ParsePositive(text.substr(0, x), "--fit width"),
-          ParsePositive(text.substr(x + 1), "--fit height")};
-}
-
 std::string FormatFromName(const std::string& name) {
   const auto ends_with = [&](const char* ext) {
     const std::string e(ext);
@@ -247,38 +206,6 @@ std::string FormatFromName(const std::string& name) {
   if (ends_with(".hpgl") || ends_with(".plt")) return "hpgl";
   if (ends_with(".json")) return "json";
   return "svg";
-}
-
-// Every output is written to a temporary file beside its destination first;
-// only when all of them are complete are they renamed into place.
-class StagedOutputs {
- public:
-  StagedOutputs() = default;
-  StagedOutputs(const StagedOutputs&) = delete;
-  StagedOutputs& operator=(const StagedOutputs&) = delete;
-  ~StagedOutputs() {
-    for (const auto& [temporary, final_name] : staged_) std::remove(temporary.c_str());
-  }
-  std::string Stage(const std::string& file) {
-    std::string temporary = file + ".fdsurf-" + std::to_string(getpid()) + ".tmp";
-    staged_.emplace_back(temporary, file);
-    return temporary;
-  }
-  void Commit() {
-    for (const auto& [temporary, final_name] : staged_) {
-      if (std::rename(temporary.c_str(), final_name.c_str()) != 0) {
-        throw OutputError(final_name + ": cannot write: " + std::strerror(errno));
-      }
-    }
-    staged_.clear();
-  }
-
- private:
-  std::vector<std::pair<std::string, std::string>> staged_;
-};
-
-bool ShowProgress(bool quiet) {
-  return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr;
 }
 
 int RunPlot(const PlotOptions& o, bool render_only) {
@@ -500,13 +427,21 @@ int Main(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Draw the patches' isolines as a PNG picture.");
   AddPlotOptions(render, &render_options, true);
 
+  StreamOptions stream_options;
+  CLI::App* stream = app.add_subcommand(
+      "stream",
+      "Stream the patches to a plotter (default: the simulated one), which evaluates them by "
+      "forward differences and draws them; report what it drew.");
+  AddStreamOptions(stream, &stream_options);
+
   // CLI11 would only say "a subcommand is required" for a mistyped command.
   const std::string first = argc > 1 ? argv[1] : "";
   if (argc > 1 && argv[1][0] != '-' && first != "sample" && first != "check" && first != "plot" &&
-      first != "render") {
-    std::fprintf(stderr,
-                 "fdsurf: error: unknown command '%s' (expected sample, check, plot or render)\n",
-                 argv[1]);
+      first != "render" && first != "stream") {
+    std::fprintf(
+        stderr,
+        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render or stream)\n",
+        argv[1]);
     return 2;
   }
   try {
@@ -519,6 +454,7 @@ int Main(int argc, char** argv) {
     if (check->parsed()) return RunCheck(check_options);
     if (plot->parsed()) return RunPlot(plot_options, false);
     if (render->parsed()) return RunPlot(render_options, true);
+    if (stream->parsed()) return RunStream(stream_options);
   } catch (const InputError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
     return 2;

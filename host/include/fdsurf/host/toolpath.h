@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fdsurf/adaptive.h"
+#include "fdsurf/forward_difference.h"
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/quantum.h"
 
@@ -97,11 +98,26 @@ struct Toolpath {
   /// The page: [0, width] × [0, height] in output units.
   double width = 0;
   double height = 0;
+  /// The drawing's extent along the view's depth, output units (3-D output
+  /// puts its top at Z = 0 and its bottom at Z = -depth).
+  double depth = 0;
   std::vector<Stroke> strokes;
 };
 
 /// Called after each patch with (patches done, patches in all, points so far).
 using Progress = std::function<void(std::size_t, std::size_t, std::size_t)>;
+
+/// Checks the options and plans the page: the output map (view, scale to
+/// --fit, centring offset), width and height. No strokes. Throws InputError
+/// as BuildToolpath.
+Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units);
+
+/// The patch's geometry in output space, in the engine's format: every
+/// control value mapped (points by the whole map, vectors by its linear
+/// part) and rounded to 2^-16 quanta. Fills geometry[0..dims). Throws
+/// EngineError (naming patch.origin) for a value beyond ±2^31 quanta.
+void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quantum, int dims,
+                   PatchGeometry1* geometry);
 
 /// Draws every patch's isolines. Throws InputError for options that cannot
 /// be met (tolerance below the quantum's reach, a drawing that does not fit)

@@ -1,0 +1,294 @@
+// The plotter firmware: the protocol endpoint, a fixed-capacity command queue,
+// the path generator and the motion loop, driven through the HAL interfaces
+// only, so the same code runs in the simulator, on a Linux host (GPIO) and on
+// an MCU. No heap: all storage is in the object, sized by the template.
+//
+// A main loop does three things, over and over:
+//
+//   device.Service(transport);   // bytes in, replies out
+//   device.Fill();               // expand commands into the lookahead buffer
+//
+// and the step timer, kTickHz times a second:
+//
+//   device.Tick(steppers, pen);  // at most one unit move or pen change
+//
+// Commands are validated when they arrive (the engine's planner runs over
+// every line a patch will draw, and every point is checked against the
+// machine's travel), so execution never meets a refusal; a command that
+// would fail is answered with an ERROR and never queued.
+#pragma once
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fdsurf/hal/outputs.h"
+#include "fdsurf/hal/transport.h"
+#include "fdsurf/motion/motion_loop.h"
+#include "fdsurf/motion/path_generator.h"
+#include "fdsurf/protocol/codec.h"
+#include "fdsurf/protocol/device_link.h"
+#include "fdsurf/protocol/messages.h"
+
+namespace fdsurf {
+namespace device {
+
+/// kAxes: 2 (a pen plotter) or 3 (a CNC with Z). kQueueCapacity: commands
+/// that can wait (the host's credit). kLookahead: unit moves and events
+/// buffered ahead of the motion, a power of two; the loop reaches full speed
+/// only if the buffer holds the braking distance (docs/motion.md).
+template <int kAxes, int kQueueCapacity = 8, int kLookahead = 1024>
+class Device {
+ public:
+  static_assert(kAxes == 2 || kAxes == 3, "2 or 3 axes");
+  static_assert(kQueueCapacity >= 1 && kQueueCapacity <= 255, "1..255 queued commands");
+  static_assert(kLookahead >= 2 && kLookahead <= 32768 && (kLookahead & (kLookahead - 1)) == 0,
+                "the lookahead is a power of two");
+
+  /// `tick_hz`: how often the caller will call Tick().
+  explicit Device(uint32_t tick_hz)
+      : tick_hz_(tick_hz), link_(this), motion_(lookahead_, kLookahead) {
+    ResetState();
+  }
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  // --- I/O --------------------------------------------------------------
+
+  void OnByte(uint8_t byte) { link_.OnByte(byte); }
+  size_t ReadOutput(uint8_t* data, size_t capacity) { return link_.ReadOutput(data, capacity); }
+
+  /// Reads what the transport has (without waiting), handles it, and sends
+  /// the replies. Returns the transport's error, if any.
+  hal::IoStatus Service(hal::Transport& transport) {
+    uint8_t buffer[64];
+    size_t received = 0;
+    const hal::IoStatus status = transport.Read(buffer, sizeof buffer, &received, 0);
+    if (status != hal::IoStatus::kOk && status != hal::IoStatus::kTimeout) return status;
+    for (size_t i = 0; i < received; ++i) link_.OnByte(buffer[i]);
+    for (;;) {
+      const size_t n = link_.ReadOutput(buffer, sizeof buffer);
+      if (n == 0) break;
+      const hal::IoStatus written = transport.Write(buffer, n, 100);
+      if (written != hal::IoStatus::kOk) return written;
+    }
+    return hal::IoStatus::kOk;
+  }
+
+  // --- Work ---------------------------------------------------------------
+
+  /// Starts queued commands and expands them into the lookahead buffer until
+  /// it is full or there is nothing left to do. A configuration waits until
+  /// everything before it has been executed, then takes effect.
+  void Fill() {
+    while (!fault_ && !motion_.Stopping() && !motion_.Full()) {
+      if (generator_.Idle()) {
+        if (queued_ == 0) return;
+        const protocol::Command& next = queue_[queue_head_];
+        if (next.type == protocol::MessageType::kConfig) {
+          if (!motion_.Idle()) return;
+          ApplyConfig(next.body.config);
+          PopCommand();
+          ++executed_;
+          continue;
+        }
+        generator_.Start(next);
+        PopCommand();
+      }
+      uint8_t entry = 0;
+      if (!generator_.Next(&entry)) {
+        if (generator_.failed()) {
+          Fault(protocol::ErrorCode::kPlannerRefused, static_cast<uint8_t>(generator_.failure()));
+        }
+        continue;
+      }
+      motion_.Push(entry);
+    }
+  }
+
+  /// One tick of the step timer: at most one unit move (one step per axis)
+  /// or one pen change, written to the outputs. An output error faults the
+  /// device (it stops; STATUS reports it).
+  hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) {
+    // After a fault the motion still comes to rest along its path, unless
+    // the outputs themselves failed.
+    if (outputs_failed_ || (fault_ && !motion_.Stopping())) return hal::IoStatus::kOk;
+    const motion::TickOutput out = motion_.Tick();
+    executed_ += out.commands_done;
+    hal::IoStatus status = hal::IoStatus::kOk;
+    if (out.pen != 0) status = pen.SetPen(out.pen > 0);
+    if (status == hal::IoStatus::kOk && out.step_mask != 0) {
+      if (!enabled_) {
+        status = steppers.SetEnabled(true);
+        enabled_ = status == hal::IoStatus::kOk;
+      }
+      const uint8_t directions = static_cast<uint8_t>((directions_ & ~out.step_mask) |
+                                                      (out.negative_mask & out.step_mask));
+      if (status == hal::IoStatus::kOk && directions != directions_) {
+        status = steppers.SetDirections(directions);
+        directions_ = directions;
+      }
+      if (status == hal::IoStatus::kOk) status = steppers.Step(out.step_mask);
+    }
+    if (status != hal::IoStatus::kOk) {
+      outputs_failed_ = true;
+      Fault(protocol::ErrorCode::kOutputFailed, static_cast<uint8_t>(status));
+      return status;
+    }
+    if (motion_.Stopping() && motion_.speed() == 0) FinishStop();
+    return hal::IoStatus::kOk;
+  }
+
+  // --- State --------------------------------------------------------------
+
+  const motion::MotionLoop& motion() const { return motion_; }
+  const protocol::DeviceLinkStats& link_stats() const { return link_.stats(); }
+  const protocol::FrameDecoderStats& frame_stats() const { return link_.frame_stats(); }
+  uint32_t executed() const { return executed_; }
+  bool Idle() const { return queued_ == 0 && generator_.Idle() && motion_.Idle(); }
+
+  // --- The protocol sink (fdsurf/protocol/device_link.h) ------------------
+
+  protocol::ErrorCode Accept(const protocol::Command& command, uint8_t* detail) {
+    *detail = 0;
+    if (motion_.Stopping()) return protocol::ErrorCode::kStopped;
+    if (command.type == protocol::MessageType::kConfig) {
+      const protocol::MachineConfig& config = command.body.config;
+      if (config.axes != kAxes) {
+        *detail = protocol::kConfigFieldAxes;
+        return protocol::ErrorCode::kDimsMismatch;
+      }
+      motion::TickLimits limits;
+      if (!motion::ToTickLimits(LimitsOf(config), &limits)) {
+        *detail = config.max_rate > tick_hz_ ? protocol::kConfigFieldMaxRate
+                                             : protocol::kConfigFieldAccel;
+        return protocol::ErrorCode::kBadField;
+      }
+      accepted_config_ = config;
+      configured_ = true;
+    } else {
+      if (!configured_) return protocol::ErrorCode::kNotConfigured;
+      const protocol::ErrorCode error =
+          motion::ValidateCommand<kAxes>(command, accepted_config_, detail);
+      if (error != protocol::ErrorCode::kNone) return error;
+    }
+    queue_[(queue_head_ + queued_) % kQueueCapacity] = command;
+    ++queued_;
+    return protocol::ErrorCode::kNone;
+  }
+  uint8_t Credits() const { return static_cast<uint8_t>(kQueueCapacity - queued_); }
+  uint8_t QueueCapacity() const { return static_cast<uint8_t>(kQueueCapacity); }
+  uint32_t TickHz() const { return tick_hz_; }
+  uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
+
+  void FillStatus(protocol::StatusReport* report) const {
+    if (fault_) {
+      report->state = protocol::DeviceState::kFault;
+    } else if (motion_.Stopping()) {
+      report->state = protocol::DeviceState::kStopping;
+    } else {
+      report->state = Idle() ? protocol::DeviceState::kIdle : protocol::DeviceState::kRunning;
+    }
+    report->error = error_;
+    report->error_detail = error_detail_;
+    report->pen_down = motion_.pen_down();
+    for (int a = 0; a < protocol::kMaxAxes; ++a) report->position[a] = motion_.position()[a];
+    report->queued = static_cast<uint8_t>(queued_);
+    report->credits = Credits();
+    report->next_seq = link_.next_seq();
+    report->executed = executed_;
+    report->moves = motion_.moves();
+  }
+
+  /// STOP: the queue is dropped now; the motion decelerates to rest along
+  /// its path, then the rest of the buffer is dropped and the pen lifted.
+  void Stop() {
+    queued_ = 0;
+    queue_head_ = 0;
+    if (motion_.Idle()) {
+      FinishStop();
+    } else {
+      motion_.Stop();
+    }
+  }
+
+  /// A new session: as STOP, and the configuration and counters are
+  /// forgotten too.
+  void Reset() {
+    Stop();
+    configured_ = false;
+    executed_ = 0;
+    fault_ = false;
+    outputs_failed_ = false;
+    error_ = protocol::ErrorCode::kNone;
+    error_detail_ = 0;
+  }
+
+ private:
+  motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
+    return motion::MotionLimits{tick_hz_, config.max_rate, config.accel, config.pen_delay_ms};
+  }
+
+  void ResetState() {
+    queued_ = 0;
+    queue_head_ = 0;
+    executed_ = 0;
+    configured_ = false;
+    fault_ = false;
+    outputs_failed_ = false;
+    enabled_ = false;
+    directions_ = 0;
+    error_ = protocol::ErrorCode::kNone;
+    error_detail_ = 0;
+    generator_.Reset(motion_.position(), false);
+  }
+
+  void ApplyConfig(const protocol::MachineConfig& config) {
+    motion::TickLimits tick;
+    // Accept() checked the same conversion.
+    if (motion::ToTickLimits(LimitsOf(config), &tick)) motion_.Configure(tick);
+  }
+
+  void PopCommand() {
+    queue_head_ = static_cast<uint8_t>((queue_head_ + 1) % kQueueCapacity);
+    --queued_;
+  }
+
+  void FinishStop() {
+    motion_.Clear();
+    generator_.Reset(motion_.position(), motion_.pen_down());
+    if (motion_.pen_down()) {
+      // Lifted through the buffer, so the pen delay is kept.
+      motion_.Push(motion::MakeEntry(motion::EntryKind::kPenUp));
+    }
+  }
+
+  void Fault(protocol::ErrorCode error, uint8_t detail) {
+    fault_ = true;
+    error_ = error;
+    error_detail_ = detail;
+    queued_ = 0;
+    queue_head_ = 0;
+    motion_.Stop();
+  }
+
+  uint32_t tick_hz_;
+  protocol::DeviceLink<Device> link_;
+  uint8_t lookahead_[kLookahead];
+  motion::MotionLoop motion_;
+  motion::PathGenerator<kAxes> generator_;
+  protocol::Command queue_[kQueueCapacity];
+  uint8_t queue_head_;
+  uint8_t queued_;
+  protocol::MachineConfig accepted_config_;
+  bool configured_;
+  bool fault_;
+  bool outputs_failed_;
+  bool enabled_;
+  uint8_t directions_;
+  protocol::ErrorCode error_;
+  uint8_t error_detail_;
+  uint32_t executed_;
+};
+
+}  // namespace device
+}  // namespace fdsurf

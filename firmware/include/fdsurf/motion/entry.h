@@ -1,0 +1,44 @@
+// Entries of the motion loop's lookahead buffer: one byte each, a unit move
+// (every axis −1, 0 or +1 step) or an event (pen up, pen down, end of a
+// command).
+#pragma once
+
+#include <stdint.h>
+
+namespace fdsurf {
+namespace motion {
+
+/// Kinds of buffer entries (the top two bits of an entry).
+enum class EntryKind : uint8_t {
+  kMove = 0,
+  kPenUp = 1,
+  kPenDown = 2,
+  /// A command finished expanding here; counted when the loop reaches it.
+  kCommandDone = 3,
+};
+
+/// One buffer entry in a byte: bits 6..7 the kind; for moves, bit 2a says
+/// axis a steps and bit 2a+1 that it steps towards negative.
+inline uint8_t MakeEntry(EntryKind kind) {
+  return static_cast<uint8_t>(static_cast<uint8_t>(kind) << 6);
+}
+inline EntryKind KindOf(uint8_t entry) { return static_cast<EntryKind>(entry >> 6); }
+
+/// A unit move from per-axis deltas in {-1, 0, 1}; axes beyond `axes` are 0.
+inline uint8_t MakeMove(const int32_t* delta, int axes) {
+  uint8_t entry = 0;
+  for (int a = 0; a < axes; ++a) {
+    if (delta[a] != 0) entry = static_cast<uint8_t>(entry | (1u << (2 * a)));
+    if (delta[a] < 0) entry = static_cast<uint8_t>(entry | (2u << (2 * a)));
+  }
+  return entry;
+}
+
+/// Length units of the profile: 2^-24 steps of path length.
+constexpr int kLengthFracBits = 24;
+/// Lengths of a unit move that steps 1, 2 or 3 axes: √k·2^24 rounded up, so
+/// that a diagonal move is never taken as shorter than it is.
+constexpr uint32_t kMoveLength[4] = {0, 16777216u, 23726567u, 29058991u};
+
+}  // namespace motion
+}  // namespace fdsurf

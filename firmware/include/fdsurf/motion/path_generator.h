@@ -1,0 +1,122 @@
+// Expands queued commands (patches, curves, straight moves, pen changes) into
+// the motion loop's entries: unit moves and pen events.
+//
+// Every path is a step-exact adaptive forward-difference path
+// (fdsurf/adaptive.h, AdaptiveMode::kStepExact): consecutive points differ by
+// at most one step per axis, and every chord between them is within the
+// command's tolerance of the exact curve. A patch is drawn as isolines with
+// the IsolineWalker: s-lines then t-lines, every other line reversed
+// (serpentine) so that pen-up travel stays short; each line starts with a
+// pen-up straight move to its first point when the pen is elsewhere. Straight
+// moves are degree-1 curves stepped the same way, so they are exactly the
+// rounded straight line.
+#pragma once
+
+#include <stdint.h>
+
+#include "fdsurf/adaptive.h"
+#include "fdsurf/motion/entry.h"
+#include "fdsurf/protocol/messages.h"
+
+namespace fdsurf {
+namespace motion {
+
+/// The tolerance used for straight moves, 2^-8 steps (a line has no chord
+/// error; only the step-exact limit matters).
+constexpr uint32_t kLineToleranceQ8 = 4 * 256;
+
+/// Checks, before a command is queued, everything that could make it fail or
+/// leave the machine's travel later: the engine's planner on every line it
+/// will step (so execution never meets a refusal), and that every point stays
+/// within [0, travel_steps] on every axis (each line's Bernstein coefficients,
+/// whose convex hull contains the line, must lie inside). Returns kNone, or
+/// kPlannerRefused with *detail = the fdsurf::Status, kOutOfTravel with
+/// *detail = the axis, kDimsMismatch.
+template <int kDims>
+protocol::ErrorCode ValidateCommand(const protocol::Command& command,
+                                    const protocol::MachineConfig& config, uint8_t* detail);
+
+/// Expands one command at a time into entries for the motion loop.
+template <int kDims>
+class PathGenerator {
+ public:
+  PathGenerator();
+
+  /// Sets where the machine is (steps) and the pen state; drops any command
+  /// in progress.
+  void Reset(const int32_t* position, bool pen_down);
+
+  /// True when no command is being expanded and every entry was handed out.
+  bool Idle() const { return stage_ == Stage::kIdle && pending_head_ >= pending_count_; }
+
+  /// Starts expanding a validated motion command (patch, curve, move, pen).
+  void Start(const protocol::Command& command);
+
+  /// The next entry of the current command; the last one is kCommandDone.
+  /// Returns false when idle. Returns false and sets failed() if the engine
+  /// refuses a line (ValidateCommand rules that out).
+  bool Next(uint8_t* entry);
+
+  bool failed() const { return failed_; }
+  Status failure() const { return failure_; }
+  const int32_t* position() const { return position_; }
+
+ private:
+  enum class Stage : uint8_t {
+    kIdle,
+    kPatchNextLine,  // take the walker's next line (or finish the patch)
+    kLineStart,      // the line is prepared: travel to its start if needed
+    kAfterTravel,    // pen down if drawing, then step the line
+    kStepping,       // the cursor runs the current path
+    kFinish,         // pen up (patch), then the command-done entry
+  };
+
+  /// Prepares `curve` into prepared_ and points the cursor at it.
+  bool PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8);
+  bool NextPoint(int32_t (&point)[kDims]);
+  /// Queues an entry to hand out before anything else.
+  void Emit(uint8_t entry);
+  /// Prepares a straight pen-at-current-state move to `target` into travel_.
+  bool StartTravel(const int32_t (&target)[kDims]);
+  void Fail(Status status);
+
+  Stage stage_;
+  protocol::MessageType type_;
+  /// Where the next stepping phase goes after the cursor is exhausted.
+  Stage after_stepping_;
+  bool lift_for_travel_;  // patches lift the pen for travel; curves keep it
+  bool pen_down_;
+  bool failed_;
+  Status failure_;
+  int32_t position_[kDims];
+
+  // Patch state.
+  IsolineWalker<kDims> walker_;
+  IsolineFamily family_;
+  uint16_t lines_t_;
+  uint16_t line_index_;
+  uint32_t tolerance_q8_;
+  protocol::PatchCommand patch_;  // kept for the t-line walker
+
+  // The line to draw (power coefficients, 2^-16 steps) and its first point;
+  // the path being stepped now (the line, or a straight travel move to it).
+  PowerCurve1 line_[kDims];
+  int32_t line_start_[kDims];
+  PreparedAdaptiveCurve<kDims> prepared_;
+  bool cursor_wide_;
+  AdaptiveCurveCursor<int64_t, kDims> cursor64_;
+  AdaptiveCurveCursor<Int128, kDims> cursor128_;
+
+  // Entries to hand out before stepping on (at most a pen event and a
+  // command-done marker at a time).
+  uint8_t pending_[2];
+  uint8_t pending_count_;
+  uint8_t pending_head_;
+};
+
+/// The power coefficients of the same curve run backwards: x(1 − u). Exact.
+template <int kDims>
+void ReverseCurve(PowerCurve1 (&curve)[kDims]);
+
+}  // namespace motion
+}  // namespace fdsurf

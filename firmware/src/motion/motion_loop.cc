@@ -1,0 +1,159 @@
+#include "fdsurf/motion/motion_loop.h"
+
+namespace fdsurf {
+namespace motion {
+
+bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
+  if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz) {
+    return false;
+  }
+  const uint64_t hz = limits.tick_hz;
+  // Rounded down, so the loop never exceeds the configured figures.
+  const uint64_t max_speed = (static_cast<uint64_t>(limits.max_rate) << kLengthFracBits) / hz;
+  const uint64_t accel = (static_cast<uint64_t>(limits.accel) << kLengthFracBits) / (hz * hz);
+  if (accel == 0 || accel > max_speed) return false;
+  out->max_speed = static_cast<uint32_t>(max_speed);
+  out->accel = static_cast<uint32_t>(accel);
+  out->pen_delay_ticks =
+      static_cast<uint32_t>(static_cast<uint64_t>(limits.pen_delay_ms) * hz / 1000);
+  return true;
+}
+
+MotionLoop::MotionLoop(uint8_t* storage, uint16_t capacity)
+    : storage_(storage), capacity_(capacity), mask_(static_cast<uint16_t>(capacity - 1)) {}
+
+uint32_t MotionLoop::LengthOf(uint8_t move) {
+  int axes = 0;
+  for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
+  return kMoveLength[axes];
+}
+
+bool MotionLoop::Push(uint8_t entry) {
+  if (count_ == capacity_) return false;
+  storage_[(head_ + count_) & mask_] = entry;
+  ++count_;
+  const EntryKind kind = KindOf(entry);
+  if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) {
+    ++stops_;
+  } else if (kind == EntryKind::kMove && stops_ == 0) {
+    distance_ += LengthOf(entry);
+  }
+  return true;
+}
+
+void MotionLoop::Pop() {
+  head_ = static_cast<uint16_t>((head_ + 1) & mask_);
+  --count_;
+}
+
+void MotionLoop::RecomputeDistance() {
+  distance_ = 0;
+  for (uint16_t i = 0; i < count_; ++i) {
+    const uint8_t entry = At(i);
+    const EntryKind kind = KindOf(entry);
+    if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) break;
+    if (kind == EntryKind::kMove) distance_ += LengthOf(entry);
+  }
+}
+
+void MotionLoop::Clear() {
+  head_ = 0;
+  count_ = 0;
+  stops_ = 0;
+  distance_ = 0;
+  phase_ = 0;
+  speed_ = 0;
+  braking_ = 0;
+  pen_wait_ = 0;
+  stopping_ = false;
+}
+
+void MotionLoop::set_position(const int32_t (&position)[3]) {
+  for (int a = 0; a < 3; ++a) position_[a] = position[a];
+}
+
+TickOutput MotionLoop::Tick() {
+  TickOutput out = {0, 0, 0, 0};
+  if (pen_wait_ > 0) {
+    --pen_wait_;
+    return out;
+  }
+  // Entries that are not moves are passed at rest (pen events) or on the fly
+  // (command boundaries).
+  while (count_ > 0 && KindOf(At(0)) != EntryKind::kMove) {
+    const EntryKind kind = KindOf(At(0));
+    Pop();
+    if (kind == EntryKind::kCommandDone) {
+      ++out.commands_done;
+      continue;
+    }
+    // A pen event is only reached with no distance left before it, where the
+    // profile guarantees speed ≤ a; stopping from there is one deceleration.
+    --stops_;
+    speed_ = 0;
+    braking_ = 0;
+    phase_ = 0;
+    RecomputeDistance();
+    const bool down = kind == EntryKind::kPenDown;
+    if (down != pen_down_) {
+      pen_down_ = down;
+      out.pen = down ? 1 : -1;
+      pen_wait_ = limits_.pen_delay_ticks;
+    }
+    return out;
+  }
+  if (stopping_ && speed_ <= limits_.accel) {
+    // At rest (or one deceleration from it): the stop is complete.
+    speed_ = 0;
+    braking_ = 0;
+    return out;
+  }
+  if (count_ == 0) {
+    speed_ = 0;
+    braking_ = 0;
+    return out;
+  }
+
+  const uint64_t available = distance_ - phase_;
+  const uint32_t a = limits_.accel;
+  const uint64_t v = speed_;
+  uint64_t advance = 0;
+  if (!stopping_ && v + a <= limits_.max_speed && (v + a) + braking_ + v <= available) {
+    braking_ += v;  // B(n+1) = B(n) + n·a
+    speed_ += a;
+    advance = speed_;
+  } else if (!stopping_ && v + braking_ <= available && v <= limits_.max_speed) {
+    advance = v;
+  } else if (v >= a) {
+    speed_ -= a;
+    braking_ -= speed_;  // B(n−1) = B(n) − (n−1)·a
+    advance = speed_;
+  }
+  if (speed_ == 0 && !stopping_) {
+    // At rest with less than one acceleration step to go: cover it exactly.
+    advance = available < a ? available : 0;
+  }
+  phase_ += static_cast<uint32_t>(advance);
+  const uint8_t head = At(0);
+  const uint32_t length = LengthOf(head);
+  if (phase_ >= length) {
+    phase_ -= length;
+    distance_ -= length;
+    Pop();
+    ++moves_;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (((head >> (2 * axis)) & 1) == 0) continue;
+      out.step_mask = static_cast<uint8_t>(out.step_mask | (1u << axis));
+      if (((head >> (2 * axis)) & 2) != 0) {
+        out.negative_mask = static_cast<uint8_t>(out.negative_mask | (1u << axis));
+        --position_[axis];
+      } else {
+        ++position_[axis];
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace motion
+}  // namespace fdsurf

@@ -1,0 +1,69 @@
+// Jobs for a device: the drawing as patches in motor steps, ready to stream.
+//
+// The host does what needs the whole drawing (the view, the fit to the page,
+// the order of the patches) and maps every patch into steps with the same
+// map and rounding that `fdsurf plot` uses (toolpath.h, PatchToQuanta, with
+// the quantum = one step). The device then evaluates the isolines itself.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/toolpath.h"
+#include "fdsurf/protocol/messages.h"
+
+namespace fdsurf::host {
+
+/// The machine, in output units (mm or in) and seconds.
+struct MachineOptions {
+  /// Length of one motor step; every position is a whole number of steps.
+  Quantum step = Quantum::Parse("0.0125");
+  /// Travel of each axis from 0; {0, 0, 0} means the page (and, in 3-D, the
+  /// drawing's depth).
+  std::array<double, 3> travel{0, 0, 0};
+  /// Path speed and acceleration limits.
+  double speed = 100;
+  double accel = 2000;
+  int pen_delay_ms = 100;
+};
+
+/// One patch as the device will draw it, for checks: the patch, and the
+/// isolines it draws.
+struct StreamedPatch {
+  std::size_t patch = 0;  // index in the patch set
+  int lines_s = 0;
+  int lines_t = 0;
+};
+
+struct StreamJob {
+  protocol::MachineConfig config{};
+  /// CONFIG first, then one PATCH per patch, in drawing order.
+  std::vector<protocol::Command> commands;
+  std::vector<std::string> labels;
+  std::vector<StreamedPatch> patches;
+  /// The page and the map from file units to output units; quantum = step.
+  Toolpath page;
+  /// Tolerance in steps, and as the devices's 2^-8-step units.
+  double tolerance_steps = 0;
+  std::uint32_t tolerance_q8 = 0;
+};
+
+/// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
+/// tolerance, dims; the quantum is replaced by machine.step). Orders the
+/// patches by nearest neighbour so that travel between them stays short.
+/// Throws InputError (options, travel too small for the page) and
+/// EngineError (a patch out of range).
+StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
+                         const MachineOptions& machine, const std::string& units);
+
+/// The isolines of the job as the exact (double) curves, in steps, sampled
+/// densely enough that the polyline is within `chord_steps` of the curve.
+/// Lines that collapse to a point are left out (the device skips them too).
+std::vector<std::vector<std::array<double, 3>>> ReferenceLines(const PatchSet& set,
+                                                               const StreamJob& job,
+                                                               double chord_steps = 0.005);
+
+}  // namespace fdsurf::host

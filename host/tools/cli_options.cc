@@ -1,0 +1,84 @@
+#include "cli_options.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include "fdsurf/forward_difference.h"
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/writers.h"
+
+namespace fdsurf::host {
+
+double ParsePositive(const std::string& text, const std::string& what, bool allow_zero) {
+  double value = 0;
+  std::size_t used = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value)) {
+    throw InputError(what + ": '" + text + "' is not a number");
+  }
+  if (value < 0 || (value == 0 && !allow_zero)) {
+    throw InputError(what + ": '" + text + "' must be " +
+                     (allow_zero ? "zero or more" : "greater than zero"));
+  }
+  return value;
+}
+
+std::array<int, 2> ParseLines(const std::string& text) {
+  const std::size_t x = text.find('x');
+  const auto parse = [&](std::string_view part) {
+    int value = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size() || value == 1 ||
+        value < 0 || value > kMaxPatchSteps + 1) {
+      throw InputError("--lines: '" + text +
+                       "' is not U or UxV with each count 0 (left out) or 2.." +
+                       std::to_string(kMaxPatchSteps + 1));
+    }
+    return value;
+  };
+  const std::string_view all(text);
+  const int u = parse(all.substr(0, x));
+  return {u, x == std::string::npos ? u : parse(all.substr(x + 1))};
+}
+
+std::array<double, 2> ParsePage(const std::string& text, const std::string& what) {
+  const std::size_t x = text.find('x');
+  if (x == std::string::npos) throw InputError(what + ": '" + text + "' is not WxH (like 200x150)");
+  return {ParsePositive(text.substr(0, x), what + " width"),
+          ParsePositive(text.substr(x + 1), what + " height")};
+}
+
+StagedOutputs::~StagedOutputs() {
+  for (const auto& [temporary, final_name] : staged_) std::remove(temporary.c_str());
+}
+
+std::string StagedOutputs::Stage(const std::string& file) {
+  std::string temporary = file + ".fdsurf-" + std::to_string(getpid()) + ".tmp";
+  staged_.emplace_back(temporary, file);
+  return temporary;
+}
+
+void StagedOutputs::Commit() {
+  for (const auto& [temporary, final_name] : staged_) {
+    if (std::rename(temporary.c_str(), final_name.c_str()) != 0) {
+      throw OutputError(final_name + ": cannot write: " + std::strerror(errno));
+    }
+  }
+  staged_.clear();
+}
+
+bool ShowProgress(bool quiet) {
+  return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr;
+}
+
+}  // namespace fdsurf::host

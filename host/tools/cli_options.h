@@ -1,0 +1,41 @@
+// Option parsing and output staging shared by the fdsurf commands.
+#pragma once
+
+#include <array>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fdsurf::host {
+
+/// A number > 0 (or ≥ 0 with allow_zero); InputError naming `what` otherwise.
+double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false);
+
+/// --lines: "U" or "UxV", each 0 (family left out) or 2..kMaxPatchSteps + 1.
+std::array<int, 2> ParseLines(const std::string& text);
+
+/// "WxH" with both > 0; `what` names the option in errors.
+std::array<double, 2> ParsePage(const std::string& text, const std::string& what = "--fit");
+
+/// Whether to draw a progress line: stderr is a terminal, not quiet, not CI.
+bool ShowProgress(bool quiet);
+
+// Every output is written to a temporary file beside its destination first;
+// only when all of them are complete are they renamed into place.
+class StagedOutputs {
+ public:
+  StagedOutputs() = default;
+  StagedOutputs(const StagedOutputs&) = delete;
+  StagedOutputs& operator=(const StagedOutputs&) = delete;
+  /// Removes whatever was staged and not committed.
+  ~StagedOutputs();
+  /// The temporary name to write `file` to.
+  std::string Stage(const std::string& file);
+  /// Renames every staged file into place; OutputError naming the file.
+  void Commit();
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;
+};
+
+}  // namespace fdsurf::host

@@ -1,0 +1,51 @@
+// `fdsurf stream`: plans a drawing, streams it as patches to a device (the
+// simulated plotter, a USB controller, or GPIO lines driven from this host)
+// and reports what happened.
+#pragma once
+
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace fdsurf::host {
+
+struct StreamOptions {
+  std::string file;
+  std::string device = "sim";
+  // The drawing, as for `fdsurf plot`.
+  std::string lines = "8";
+  std::string view = "iso";
+  std::string units = "mm";
+  std::string fit = "200x150";
+  std::string margin;
+  std::string tolerance;
+  int dims = 2;
+  // The machine.
+  std::string step;
+  std::string travel;
+  double speed = 100;
+  double accel = 2000;
+  int pen_delay_ms = 100;
+  std::uint32_t tick_hz = 0;
+  // The link and the simulator.
+  std::uint64_t link_bytes_per_second = 1'000'000;
+  double faults = 0;
+  std::uint64_t seed = 1;
+  std::string svg;
+  std::string png;
+  int png_width = 1600;
+  bool quiet = false;
+};
+
+/// Adds the options of `stream` to `command`.
+void AddStreamOptions(CLI::App* command, StreamOptions* options);
+
+/// Runs the command: 0 when the job finished within the bound and the
+/// limits, 1 when the simulated plotter saw the bound or a limit broken,
+/// 2 for bad input, 3 when the device refused the job or the link failed.
+/// Throws InputError / OutputError / EngineError as the other commands do.
+int RunStream(const StreamOptions& options);
+
+}  // namespace fdsurf::host

@@ -1,0 +1,241 @@
+#include "fdsurf/sim/plotter.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "fdsurf/device/device.h"
+
+namespace fdsurf::sim {
+
+namespace internal {
+
+// The firmware's Device for 2 or 3 axes behind one interface.
+class DeviceRunner {
+ public:
+  virtual ~DeviceRunner() = default;
+  virtual hal::IoStatus Service(hal::Transport& transport) = 0;
+  virtual void Fill() = 0;
+  virtual hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) = 0;
+  virtual const protocol::DeviceLinkStats& link_stats() const = 0;
+  virtual const protocol::FrameDecoderStats& frame_stats() const = 0;
+  virtual std::uint32_t executed() const = 0;
+};
+
+}  // namespace internal
+
+namespace {
+
+// The same queue and lookahead a Raspberry Pi or a Cortex-M4 build would use.
+template <int kAxes>
+class AxesRunner final : public internal::DeviceRunner {
+ public:
+  explicit AxesRunner(std::uint32_t tick_hz) : device_(tick_hz) {}
+  hal::IoStatus Service(hal::Transport& transport) override { return device_.Service(transport); }
+  void Fill() override { device_.Fill(); }
+  hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) override {
+    return device_.Tick(steppers, pen);
+  }
+  const protocol::DeviceLinkStats& link_stats() const override { return device_.link_stats(); }
+  const protocol::FrameDecoderStats& frame_stats() const override { return device_.frame_stats(); }
+  std::uint32_t executed() const override { return device_.executed(); }
+
+ private:
+  device::Device<kAxes, 8, 1024> device_;
+};
+
+}  // namespace
+
+// The device's end of the link, with faults injected into what it sends.
+class SimulatedPlotter::FaultyTransport final : public hal::Transport {
+ public:
+  FaultyTransport(hal::Transport& inner, FaultRates rates, std::uint64_t seed)
+      : inner_(inner), faults_(rates, seed) {}
+  ~FaultyTransport() = default;
+  FaultyTransport(const FaultyTransport&) = delete;
+  FaultyTransport& operator=(const FaultyTransport&) = delete;
+  const FaultStats& stats() const { return faults_.stats(); }
+
+ private:
+  hal::IoStatus DoWrite(const std::uint8_t* data, std::size_t size,
+                        std::uint32_t timeout_ms) override {
+    faulted_.clear();
+    faults_.Process(data, size, &faulted_);
+    if (faulted_.empty()) return hal::IoStatus::kOk;
+    return inner_.Write(faulted_.data(), faulted_.size(), timeout_ms);
+  }
+  hal::IoStatus DoRead(std::uint8_t* data, std::size_t capacity, std::size_t* received,
+                       std::uint32_t timeout_ms) override {
+    return inner_.Read(data, capacity, received, timeout_ms);
+  }
+  hal::IoStatus DoReconnect(std::uint32_t timeout_ms) override {
+    return inner_.Reconnect(timeout_ms);
+  }
+  const char* DoLastError() const override { return inner_.LastError(); }
+
+  hal::Transport& inner_;
+  FaultLink faults_;
+  std::vector<std::uint8_t> faulted_;
+};
+
+SimulatedPlotter::SimulatedPlotter(const PlotterOptions& options)
+    : options_(options),
+      steps_(clock_, static_cast<std::uint8_t>(options.axes)),
+      pen_(clock_),
+      link_(clock_, hal::SimLinkOptions{options.latency_us, options.bytes_per_second, 0}) {
+  if (options.axes != 2 && options.axes != 3) {
+    throw std::invalid_argument("the simulated plotter has 2 or 3 axes");
+  }
+  if (options.tick_hz == 0 || 1'000'000 % options.tick_hz != 0) {
+    throw std::invalid_argument("the simulated tick rate must divide 1 MHz");
+  }
+  device_end_ =
+      std::make_unique<FaultyTransport>(link_.device(), options.to_host, options.fault_seed + 1);
+  if (options.axes == 2) {
+    runner_ = std::make_unique<AxesRunner<2>>(options.tick_hz);
+  } else {
+    runner_ = std::make_unique<AxesRunner<3>>(options.tick_hz);
+  }
+}
+
+SimulatedPlotter::~SimulatedPlotter() = default;
+
+void SimulatedPlotter::ScheduleUnplug(std::uint64_t at_us, std::uint64_t back_us) {
+  unplug_scheduled_ = true;
+  unplug_at_us_ = at_us;
+  replug_at_us_ = back_us;
+}
+
+RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_us,
+                                const std::function<void(const RunProgress&)>& progress,
+                                std::uint64_t progress_interval_us) {
+  const std::uint64_t tick_us = 1'000'000 / options_.tick_hz;
+  // The host's PC polls its port about every millisecond.
+  constexpr std::uint64_t kHostPollUs = 1000;
+  FaultLink to_device(options_.to_device, options_.fault_seed);
+  std::vector<std::uint8_t> out;
+  std::vector<std::uint8_t> faulted;
+  std::uint8_t in[512];
+  bool host_down = false;
+  bool device_down = false;
+  std::uint64_t next_host_poll = 0;
+  std::uint64_t next_progress = progress_interval_us;
+
+  RunResult result;
+  for (;;) {
+    const std::uint64_t now = clock_.now_us();
+    if (link.Finished() || link.Failed() || now >= time_limit_us) break;
+    if (unplug_scheduled_ && now >= unplug_at_us_) {
+      unplug_scheduled_ = false;
+      link_.Disconnect();
+      link_.PlugInAt(replug_at_us_);
+    }
+
+    // The host: take replies, then send what the link wants sent.
+    if (host_down) {
+      if (link_.host().Reconnect(0) == hal::IoStatus::kOk) {
+        host_down = false;
+        link.Resume();
+        next_host_poll = now;
+      }
+    } else {
+      for (;;) {
+        std::size_t got = 0;
+        const hal::IoStatus read = link_.host().Read(in, sizeof in, &got, 0);
+        if (read == hal::IoStatus::kDisconnected) host_down = true;
+        if (read != hal::IoStatus::kOk) break;
+        link.OnBytes(in, got, now);
+        next_host_poll = now;  // an acknowledgement may open the window
+      }
+      if (!host_down && now >= next_host_poll) {
+        out.clear();
+        link.Poll(now, &out);
+        if (!out.empty()) {
+          faulted.clear();
+          to_device.Process(out.data(), out.size(), &faulted);
+          if (!faulted.empty() && link_.host().Write(faulted.data(), faulted.size(), 0) ==
+                                      hal::IoStatus::kDisconnected) {
+            host_down = true;
+          }
+        }
+        next_host_poll = std::max(now + tick_us, std::min(link.NextPollUs(now), now + kHostPollUs));
+      }
+    }
+
+    // The device: its main loop, then one tick of its step timer.
+    if (device_down) {
+      device_down = device_end_->Reconnect(0) != hal::IoStatus::kOk;
+    } else {
+      device_down = runner_->Service(*device_end_) == hal::IoStatus::kDisconnected;
+    }
+    runner_->Fill();
+    runner_->Tick(steps_, pen_);
+    clock_.Advance(tick_us);
+
+    if (progress && now >= next_progress) {
+      next_progress = now + progress_interval_us;
+      progress(RunProgress{now, link.acknowledged(), runner_->executed(), link.enqueued(),
+                           link.stats().frames_sent});
+    }
+  }
+  result.time_us = clock_.now_us();
+  result.finished = link.Finished();
+  if (link.Failed()) {
+    result.error = link.error();
+  } else if (!result.finished) {
+    result.error = "the job did not finish within " + std::to_string(time_limit_us / 1'000'000) +
+                   " s of machine time";
+  }
+  result.executed = runner_->executed();
+  result.host = link.stats();
+  result.device = runner_->link_stats();
+  result.device_frames = runner_->frame_stats();
+  result.faults_to_device = to_device.stats();
+  result.faults_to_host = device_end_->stats();
+  return result;
+}
+
+std::array<std::int64_t, 3> SimulatedPlotter::position() const {
+  return {steps_.position(0), steps_.position(1), options_.axes == 3 ? steps_.position(2) : 0};
+}
+
+std::vector<DrawnPath> SimulatedPlotter::DrawnPaths() const {
+  return ReplayEvents(steps_.events(), pen_.events());
+}
+
+std::vector<DrawnPath> ReplayEvents(const std::vector<hal::StepDirEvent>& steps,
+                                    const std::vector<hal::PenEvent>& pens) {
+  std::vector<DrawnPath> paths;
+  std::array<std::int64_t, 3> position{0, 0, 0};
+  bool down = false;
+  DrawnPath current;
+  const auto finish = [&] {
+    if (current.points.size() >= 2) paths.push_back(std::move(current));
+    current = DrawnPath{};
+  };
+  std::size_t p = 0;
+  for (const hal::StepDirEvent& event : steps) {
+    // Pen changes and steps never share a tick; a pen event at or before
+    // this step's time happened first.
+    while (p < pens.size() && pens[p].time_us <= event.time_us) {
+      if (pens[p].down && !down) current.points.push_back(position);
+      if (!pens[p].down && down) finish();
+      down = pens[p].down;
+      ++p;
+    }
+    if (event.axis_mask == 0) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      if ((event.axis_mask >> axis & 1) == 0) continue;
+      position[axis] += (event.negative_mask >> axis & 1) != 0 ? -1 : 1;
+    }
+    if (down) current.points.push_back(position);
+  }
+  for (; p < pens.size(); ++p) {
+    if (pens[p].down && !down) current.points.push_back(position);
+    if (!pens[p].down && down) finish();
+    down = pens[p].down;
+  }
+  finish();
+  return paths;
+}
+
+}  // namespace fdsurf::sim
