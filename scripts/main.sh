@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Sets everything up and runs fdsurf's main job on its default input: draws
-# the Utah teapot (examples/teapot.bpt) as a wireframe of isolines, with
-# adaptive forward differences within 0.05 mm, as an SVG for a pen plotter
-# and a PNG to look at, both in build/.
+# Sets everything up and runs fdsurf's main job on its default target, the
+# simulated plotter: streams the Utah teapot (examples/teapot.bpt) as 32
+# Bézier patches to the firmware running over the in-memory HAL, which draws
+# their isolines by step-exact forward differences; then shows what it drew
+# (build/teapot.svg, build/teapot.png) and how it compares with the exact
+# surface and the machine's limits. No hardware needed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-./build/fdsurf plot examples/teapot.bpt --fit 200x150 -o build/teapot.svg --png build/teapot.png
-echo "open build/teapot.svg or build/teapot.png to see the drawing"
+./build/fdsurf stream examples/teapot.bpt --svg build/teapot.svg --png build/teapot.png
+echo "open build/teapot.svg or build/teapot.png to see what the simulated plotter drew"

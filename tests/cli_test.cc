@@ -239,5 +239,45 @@ TEST_F(Cli, PlotWritesEachFormat) {
   }
 }
 
+TEST_F(Cli, StreamDrawsOnTheSimulatedPlotterAndReports) {
+  const std::string svg = (dir_ / "drawn.svg").string();
+  const std::string png = (dir_ / "drawn.png").string();
+  const RunResult r = Run("stream '" + kTeapot + "' --fit 40x30 --lines 3 --pen-delay 5 --svg '" +
+                          svg + "' --png '" + png + "' --size 300");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("32 patches streamed to the simulated plotter"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bytes of G-code for the same drawing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(--tolerance): within"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pen delay 5 ms): kept"), std::string::npos) << r.err;
+  EXPECT_NE(Slurp(svg).find("<svg"), std::string::npos);
+  EXPECT_EQ(Slurp(png).substr(1, 3), "PNG");
+  // Through a lossy link: the same result, with retransmissions reported.
+  const RunResult lossy =
+      Run("stream '" + kTeapot + "' --fit 40x30 --lines 3 --pen-delay 5 --faults 0.05 --seed 9");
+  ASSERT_EQ(lossy.exit_code, 0) << lossy.err;
+  EXPECT_NE(lossy.err.find("(--tolerance): within"), std::string::npos) << lossy.err;
+  EXPECT_EQ(lossy.err.find(" 0 resent"), std::string::npos) << lossy.err;
+}
+
+TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
+  ExpectRefused("stream '" + kTeapot + "' --device serial", "--device: 'serial' is not sim");
+  ExpectRefused("stream '" + kTeapot + "' --device usb --faults 0.1",
+                "--svg, --png and --faults are for --device sim");
+  ExpectRefused("stream '" + kTeapot + "' --travel 100x100", "--travel X 100 mm is smaller than");
+  ExpectRefused("stream '" + kTeapot + "' --tolerance 0.005", "--tolerance 0.005 mm is too small");
+  ExpectRefused("stream '" + kTeapot + "' --tick-hz 30000", "--tick-hz: 30000 does not divide");
+  ExpectRefused("stream '" + kTeapot + "' --device gpio:gpiochip0:1,2,3", "--device: ");
+  // No such hardware here: a clear message and exit code 3.
+  const RunResult usb = Run("stream '" + kTeapot + "' --device usb:1209:0001");
+  EXPECT_EQ(usb.exit_code, 3) << usb.err;
+  EXPECT_NE(usb.err.find("1209:0001"), std::string::npos) << usb.err;
+  const RunResult gpio = Run("stream '" + kTeapot + "' --device gpio:gpiochip99:1,2,3,4,5,6");
+  EXPECT_EQ(gpio.exit_code, 3) << gpio.err;
+  EXPECT_NE(gpio.err.find("gpiochip99"), std::string::npos) << gpio.err;
+  // A tolerance that whole steps cannot keep is refused before anything moves.
+  EXPECT_EQ(Run("stream '" + kTeapot + "' --step 0.1 --tolerance 0.05").exit_code, 2);
+}
+
 }  // namespace
 }  // namespace fdsurf::host

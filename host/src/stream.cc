@@ -80,8 +80,10 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     if (c >= t.dims) continue;
     const double travel = machine.travel[c] > 0 ? machine.travel[c] : std::max(page[c], step);
     if (travel < page[c] - 1e-9) {
-      throw InputError(std::string(names[c]) + " " + Number(travel) + " " + units +
-                       " is smaller than the page (" + Number(page[c]) + " " + units + ")");
+      std::string message = names[c];
+      message += " " + Number(travel) + " " + units;
+      message += " is smaller than the page (" + Number(page[c]) + " " + units + ")";
+      throw InputError(message);
     }
     config.travel_steps[c] = ToSteps(travel, machine.step, names[c]);
     const double meters = step * (units == "in" ? 0.0254 : 0.001);

@@ -31,6 +31,14 @@ std::string Number(double v, int digits = 6) {
   return text;
 }
 
+// Status queries four times a second: enough for the progress line and for
+// noticing the end, few enough to leave the link to the commands.
+HostLinkOptions LinkOptions() {
+  HostLinkOptions options;
+  options.status_interval_us = 250'000;
+  return options;
+}
+
 // A device-side failure or a link that could not be recovered.
 class DeviceError : public std::runtime_error {
  public:
@@ -168,7 +176,7 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   plotter_options.to_host = sim::FaultRates::All(o.faults);
   plotter_options.fault_seed = o.seed;
   sim::SimulatedPlotter plotter(plotter_options);
-  HostLink link;
+  HostLink link(LinkOptions());
   Enqueue(job, &link);
 
   ProgressLine progress(ShowProgress(o.quiet));
@@ -222,13 +230,13 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                  o.file.c_str(), job.patches.size(), plotter_options.axes, plotter_options.tick_hz);
     std::fprintf(stderr,
                  "link: %llu frames sent (%llu commands, %llu resent), %llu bytes to the device, "
-                 "%llu NAKs, %llu timeouts\n",
+                 "%llu NAKs, %llu timeouts; all acknowledged after %.2f s\n",
                  static_cast<unsigned long long>(run.host.frames_sent),
                  static_cast<unsigned long long>(run.host.commands_sent),
                  static_cast<unsigned long long>(run.host.retransmitted),
                  static_cast<unsigned long long>(run.host.bytes_sent),
                  static_cast<unsigned long long>(run.host.naks),
-                 static_cast<unsigned long long>(run.host.timeouts));
+                 static_cast<unsigned long long>(run.host.timeouts), run.acknowledged_us * 1e-6);
     std::fprintf(stderr,
                  "wire: %zu bytes of patch frames vs %zu bytes of G-code for the same drawing at "
                  "the same tolerance (%.1fx smaller)\n",
@@ -267,7 +275,7 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
   if (hal::UsbTransport::Open(selector, hal::UsbOptions{}, &usb, &error) != hal::IoStatus::kOk) {
     throw DeviceError(error);
   }
-  HostLink link;
+  HostLink link(LinkOptions());
   Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
   std::vector<std::uint8_t> out;
@@ -326,7 +334,7 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
     throw DeviceError(error);
   }
   const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
-  HostLink link;
+  HostLink link(LinkOptions());
   Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
   hal::MonotonicClock clock;

@@ -195,8 +195,10 @@ MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
   }
 
   // Between two rests (the start, pen changes) the machine starts from rest
-  // and comes to rest: x ≤ a·(t − t0 + tick)²/2 after the start, and the
-  // distance left ≤ a·(t1 − t + tick)²/2 before the stop.
+  // and comes to rest: x ≤ a·(t − t0 + 1.5·tick)²/2 after the start, and the
+  // distance left ≤ a·(t1 − t + 1.5·tick)²/2 before the stop. The 1.5 ticks
+  // allow for speed changing in whole ticks: k ticks of a speed that grows
+  // by a·tick each cover a·tick²·k(k+1)/2 ≤ a·((k + 1/2)·tick)²/2.
   std::vector<double> rests{0.0};
   for (const hal::PenEvent& pen : pens) rests.push_back(pen.time_us * 1e-6);
   std::size_t k = 0;
@@ -211,7 +213,7 @@ MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
     const double end = distance[k - 1];
     for (std::size_t i = first; i < k; ++i) {
       const double from_start = distance[i] - base;
-      const double span = time[i] - start + tick_s;
+      const double span = time[i] - start + 1.5 * tick_s;
       if (from_start > 0.5 * a * span * span + 1e-9) {
         violation(
             describe("%.2f steps covered %.6f s after a start from rest (accel limit allows %.2f)",
@@ -219,7 +221,7 @@ MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
       }
       if (stops) {
         const double left = end - distance[i];
-        const double until = stop - time[i] + tick_s;
+        const double until = stop - time[i] + 1.5 * tick_s;
         if (left > 0.5 * a * until * until + 1e-9) {
           violation(
               describe("%.2f steps left %.6f s before a stop at rest (accel limit allows %.2f)",

@@ -124,6 +124,7 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
   for (;;) {
     const std::uint64_t now = clock_.now_us();
     if (link.Finished() || link.Failed() || now >= time_limit_us) break;
+    if (result.acknowledged_us == 0 && link.AllAcknowledged()) result.acknowledged_us = now;
     if (unplug_scheduled_ && now >= unplug_at_us_) {
       unplug_scheduled_ = false;
       link_.Disconnect();

@@ -184,26 +184,6 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
 }
 
 template <int kDims>
-PathGenerator<kDims>::PathGenerator()
-    : stage_(Stage::kIdle),
-      type_(MessageType::kPen),
-      after_stepping_(Stage::kIdle),
-      lift_for_travel_(false),
-      pen_down_(false),
-      failed_(false),
-      failure_(Status::kOk),
-      position_(),
-      family_(IsolineFamily::kSLines),
-      lines_t_(0),
-      line_index_(0),
-      tolerance_q8_(0),
-      line_start_(),
-      cursor_wide_(false),
-      pending_(),
-      pending_count_(0),
-      pending_head_(0) {}
-
-template <int kDims>
 void PathGenerator<kDims>::Reset(const int32_t* position, bool pen_down) {
   for (int c = 0; c < kDims; ++c) position_[c] = position[c];
   pen_down_ = pen_down;

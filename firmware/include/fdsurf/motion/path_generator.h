@@ -8,8 +8,8 @@
 // the IsolineWalker: s-lines then t-lines, every other line reversed
 // (serpentine) so that pen-up travel stays short; each line starts with a
 // pen-up straight move to its first point when the pen is elsewhere. Straight
-// moves are degree-1 curves stepped the same way, so they are exactly the
-// rounded straight line.
+// moves are degree-1 curves stepped the same way: every point is a point of
+// the exact line with its coordinates rounded.
 #pragma once
 
 #include <stdint.h>
@@ -40,7 +40,7 @@ protocol::ErrorCode ValidateCommand(const protocol::Command& command,
 template <int kDims>
 class PathGenerator {
  public:
-  PathGenerator();
+  PathGenerator() = default;
 
   /// Sets where the machine is (steps) and the pen state; drops any command
   /// in progress.
@@ -80,38 +80,38 @@ class PathGenerator {
   bool StartTravel(const int32_t (&target)[kDims]);
   void Fail(Status status);
 
-  Stage stage_;
-  protocol::MessageType type_;
+  Stage stage_ = Stage::kIdle;
+  protocol::MessageType type_ = protocol::MessageType::kPen;
   /// Where the next stepping phase goes after the cursor is exhausted.
-  Stage after_stepping_;
-  bool lift_for_travel_;  // patches lift the pen for travel; curves keep it
-  bool pen_down_;
-  bool failed_;
-  Status failure_;
-  int32_t position_[kDims];
+  Stage after_stepping_ = Stage::kIdle;
+  bool lift_for_travel_ = false;  // patches lift the pen for travel; curves keep it
+  bool pen_down_ = false;
+  bool failed_ = false;
+  Status failure_ = Status::kOk;
+  int32_t position_[kDims] = {};
 
   // Patch state.
   IsolineWalker<kDims> walker_;
-  IsolineFamily family_;
-  uint16_t lines_t_;
-  uint16_t line_index_;
-  uint32_t tolerance_q8_;
+  IsolineFamily family_ = IsolineFamily::kSLines;
+  uint16_t lines_t_ = 0;
+  uint16_t line_index_ = 0;
+  uint32_t tolerance_q8_ = 0;
   protocol::PatchCommand patch_;  // kept for the t-line walker
 
   // The line to draw (power coefficients, 2^-16 steps) and its first point;
   // the path being stepped now (the line, or a straight travel move to it).
   PowerCurve1 line_[kDims];
-  int32_t line_start_[kDims];
+  int32_t line_start_[kDims] = {};
   PreparedAdaptiveCurve<kDims> prepared_;
-  bool cursor_wide_;
+  bool cursor_wide_ = false;
   AdaptiveCurveCursor<int64_t, kDims> cursor64_;
   AdaptiveCurveCursor<Int128, kDims> cursor128_;
 
   // Entries to hand out before stepping on (at most a pen event and a
   // command-done marker at a time).
-  uint8_t pending_[2];
-  uint8_t pending_count_;
-  uint8_t pending_head_;
+  uint8_t pending_[2] = {};
+  uint8_t pending_count_ = 0;
+  uint8_t pending_head_ = 0;
 };
 
 /// The power coefficients of the same curve run backwards: x(1 − u). Exact.

@@ -50,6 +50,8 @@ struct RunResult {
   /// Why not, when !finished: the link's error, or a time-out.
   std::string error;
   std::uint64_t time_us = 0;
+  /// When the device had acknowledged every command (virtual time).
+  std::uint64_t acknowledged_us = 0;
   std::uint64_t executed = 0;
   host::HostLinkStats host;
   protocol::DeviceLinkStats device;

@@ -1,0 +1,562 @@
+// The firmware's motion side: the velocity profile of the motion loop, the
+// path generator's expansion of patches, curves and moves, and the device's
+// validation, STOP and faults. References are independent: exact curves in
+// long double written out here, the ideal continuous trapezoid, and the
+// simulator's event-based limit checks (whose own ability to fail is tested
+// in sim_test.cc).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "fdsurf/device/device.h"
+#include "fdsurf/hal/sim.h"
+#include "fdsurf/motion/motion_loop.h"
+#include "fdsurf/motion/path_generator.h"
+#include "fdsurf/sim/checks.h"
+#include "fdsurf/sim/plotter.h"
+
+namespace fdsurf {
+namespace {
+
+using motion::EntryKind;
+using motion::MakeEntry;
+using motion::MakeMove;
+using motion::MotionLoop;
+using motion::TickOutput;
+
+constexpr std::uint32_t kTickHz = 40000;
+
+motion::TickLimits Limits(std::uint32_t max_rate, std::uint32_t accel,
+                          std::uint16_t pen_delay_ms = 0) {
+  motion::TickLimits limits{};
+  EXPECT_TRUE(motion::ToTickLimits({kTickHz, max_rate, accel, pen_delay_ms}, &limits));
+  return limits;
+}
+
+// Runs the loop to idle, recording what it did as the sim HAL would.
+struct Recording {
+  std::vector<hal::StepDirEvent> steps;
+  std::vector<hal::PenEvent> pens;
+  std::uint64_t ticks = 0;
+  std::uint32_t commands_done = 0;
+};
+
+void Record(const TickOutput& out, std::uint64_t tick, Recording* r) {
+  const std::uint64_t us = tick * (1'000'000 / kTickHz);
+  if (out.step_mask != 0) r->steps.push_back({us, out.step_mask, out.negative_mask, true});
+  if (out.pen != 0) r->pens.push_back({us, out.pen > 0});
+  r->commands_done += out.commands_done;
+}
+
+Recording RunToIdle(MotionLoop* loop, std::uint64_t limit = 50'000'000) {
+  Recording r;
+  while (!loop->Idle() && r.ticks < limit) {
+    Record(loop->Tick(), r.ticks, &r);
+    ++r.ticks;
+  }
+  return r;
+}
+
+sim::MotionLimitsSi SiLimits(double max_rate, double accel, double pen_delay_s = 0) {
+  sim::MotionLimitsSi limits;
+  limits.tick_hz = kTickHz;
+  limits.max_rate = max_rate;
+  limits.accel = accel;
+  limits.pen_delay_s = pen_delay_s;
+  return limits;
+}
+
+// The time a continuous trapezoid needs for `distance` from rest to rest.
+double IdealSeconds(double distance, double speed, double accel) {
+  if (distance >= speed * speed / accel) return distance / speed + speed / accel;
+  return 2 * std::sqrt(distance / accel);
+}
+
+TEST(MotionLimits, RefusesWhatTheLoopCannotServe) {
+  motion::TickLimits limits{};
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kTickHz + 1, 1000, 0}, &limits));  // > 1 step/tick
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 0, 1000, 0}, &limits));
+  // 10 steps/s² at 40 kHz is 10·2^24/1.6e9 ≈ 0.1 units per tick²: not representable.
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 1000, 10, 0}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100}, &limits));
+  EXPECT_EQ(limits.max_speed, 3355443u);  // 8000·2^24/40000, rounded down
+  EXPECT_EQ(limits.accel, 1677u);         // 160000·2^24/40000², rounded down
+  EXPECT_EQ(limits.pen_delay_ticks, 4000u);
+}
+
+TEST(MotionLoop, StraightRunIsATrapezoidWithinTheLimits) {
+  std::vector<std::uint8_t> storage(4096);
+  for (const int steps : {1, 7, 150, 1000, 3000}) {
+    MotionLoop loop(storage.data(), static_cast<std::uint16_t>(storage.size()));
+    loop.Configure(Limits(8000, 160000));
+    const std::int32_t right[2] = {1, 0};
+    for (int i = 0; i < steps; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
+    ASSERT_TRUE(loop.Push(MakeEntry(EntryKind::kPenUp)));  // a rest at the end
+    const Recording r = RunToIdle(&loop);
+    ASSERT_EQ(r.steps.size(), static_cast<std::size_t>(steps));
+    EXPECT_EQ(loop.position()[0], steps);
+    const sim::MotionReport report =
+        sim::CheckMotion(r.steps, r.pens, SiLimits(8000, 160000), 0.02);
+    EXPECT_EQ(report.violations, 0u) << steps << " steps: " << report.first_violation;
+    // Not needlessly slow either: within 2% (plus a few ticks) of the ideal trapezoid.
+    const double ideal = IdealSeconds(steps, 8000, 160000);
+    EXPECT_LE(r.ticks, ideal * kTickHz * 1.02 + 5) << steps << " steps";
+  }
+}
+
+TEST(MotionLoop, DiagonalMovesCountTheirLength) {
+  std::vector<std::uint8_t> storage(4096);
+  MotionLoop loop(storage.data(), 4096);
+  loop.Configure(Limits(8000, 160000));
+  const std::int32_t diagonal[3] = {1, -1, 1};
+  for (int i = 0; i < 3000; ++i) ASSERT_TRUE(loop.Push(MakeMove(diagonal, 3)));
+  ASSERT_TRUE(loop.Push(MakeEntry(EntryKind::kPenUp)));
+  const Recording r = RunToIdle(&loop);
+  const sim::MotionReport report = sim::CheckMotion(r.steps, r.pens, SiLimits(8000, 160000));
+  EXPECT_EQ(report.violations, 0u) << report.first_violation;
+  // The Euclidean path speed, √3 per move, tops out at the limit.
+  EXPECT_GT(report.max_speed, 8000 * 0.97);
+  EXPECT_EQ(loop.position()[1], -3000);
+}
+
+TEST(MotionLoop, RandomPathsWithPenEventsAndStarvationKeepTheLimits) {
+  std::mt19937_64 rng(7);
+  std::vector<std::uint8_t> storage(256);
+  for (int trial = 0; trial < 20; ++trial) {
+    MotionLoop loop(storage.data(), 256);
+    const std::uint32_t rate = 2000 + static_cast<std::uint32_t>(rng() % 20000);
+    const std::uint32_t accel = 20000 + static_cast<std::uint32_t>(rng() % 400000);
+    loop.Configure(Limits(rate, accel, 5));
+    // The producer feeds a random number of entries between ticks, sometimes none.
+    std::vector<std::uint8_t> entries;
+    std::array<std::int64_t, 3> expected{0, 0, 0};
+    for (int i = 0; i < 6000; ++i) {
+      if (rng() % 400 == 0) {
+        entries.push_back(MakeEntry(rng() % 2 ? EntryKind::kPenDown : EntryKind::kPenUp));
+        continue;
+      }
+      std::int32_t delta[3];
+      for (int a = 0; a < 3; ++a) delta[a] = static_cast<std::int32_t>(rng() % 3) - 1;
+      if (delta[0] == 0 && delta[1] == 0 && delta[2] == 0) delta[0] = 1;
+      for (int a = 0; a < 3; ++a) expected[a] += delta[a];
+      entries.push_back(MakeMove(delta, 3));
+    }
+    entries.push_back(MakeEntry(EntryKind::kPenUp));
+    entries.push_back(MakeEntry(EntryKind::kPenDown));  // the last rest is a pen event
+    Recording r;
+    std::size_t next = 0;
+    while ((next < entries.size() || !loop.Idle()) && r.ticks < 100'000'000) {
+      const std::uint64_t feed = rng() % 8 == 0 ? 0 : rng() % 6;
+      for (std::uint64_t k = 0; k < feed && next < entries.size() && !loop.Full(); ++k) {
+        ASSERT_TRUE(loop.Push(entries[next++]));
+      }
+      Record(loop.Tick(), r.ticks, &r);
+      ++r.ticks;
+    }
+    ASSERT_TRUE(loop.Idle());
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(loop.position()[a], expected[a]) << "axis " << a;
+    const sim::MotionReport report =
+        sim::CheckMotion(r.steps, r.pens, SiLimits(rate, accel, 5e-3), 0.02);
+    EXPECT_EQ(report.violations, 0u) << "trial " << trial << ": " << report.first_violation;
+  }
+}
+
+TEST(MotionLoop, StopDeceleratesAlongThePathWithinTheLimit) {
+  std::vector<std::uint8_t> storage(4096);
+  MotionLoop loop(storage.data(), 4096);
+  const motion::TickLimits limits = Limits(8000, 160000);
+  loop.Configure(limits);
+  const std::int32_t right[2] = {1, 0};
+  for (int i = 0; i < 4000; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
+  for (int t = 0; t < 3000; ++t) loop.Tick();  // well under way, at full speed
+  const std::uint32_t before = loop.speed();
+  ASSERT_GT(before, limits.accel * 1000);
+  loop.Stop();
+  std::uint32_t previous = before;
+  int ticks = 0;
+  while (loop.speed() > 0 && ticks < 100000) {
+    loop.Tick();
+    EXPECT_LE(previous - loop.speed(), limits.accel);  // never faster than the limit
+    previous = loop.speed();
+    ++ticks;
+  }
+  EXPECT_EQ(loop.speed(), 0u);
+  EXPECT_LE(ticks, static_cast<int>(before / limits.accel) + 2);
+  EXPECT_TRUE(loop.Stopping());
+}
+
+// --- The path generator --------------------------------------------------
+
+// x(u) per axis from power coefficients in 2^-16 steps, in long double.
+long double Evaluate(const PowerCurve1& c, long double u) {
+  return (((c.c[0] * u + c.c[1]) * u + c.c[2]) * u + c.c[3]) / 65536.0L;
+}
+
+TEST(ReverseCurve, RunsTheSameCurveBackwards) {
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<std::int64_t> coefficient(-(std::int64_t{1} << 40),
+                                                          std::int64_t{1} << 40);
+  for (int trial = 0; trial < 200; ++trial) {
+    PowerCurve1 curve[2];
+    for (auto& axis : curve) {
+      for (auto& c : axis.c) c = coefficient(rng);
+    }
+    PowerCurve1 reversed[2] = {curve[0], curve[1]};
+    motion::ReverseCurve(reversed);
+    for (int k = 0; k <= 16; ++k) {
+      const long double u = k / 16.0L;
+      for (int a = 0; a < 2; ++a) {
+        EXPECT_NEAR(static_cast<double>(Evaluate(reversed[a], u)),
+                    static_cast<double>(Evaluate(curve[a], 1 - u)), 1e-6);
+      }
+    }
+  }
+}
+
+protocol::MachineConfig Config(std::int32_t travel) {
+  protocol::MachineConfig config{};
+  config.axes = 2;
+  config.steps_per_meter[0] = config.steps_per_meter[1] = 80000;
+  config.travel_steps[0] = config.travel_steps[1] = travel;
+  config.max_rate = 8000;
+  config.accel = 160000;
+  config.pen_delay_ms = 10;
+  return config;
+}
+
+// A Bézier patch over [x0, x0 + size]², a bump of `height` in y.
+protocol::Command BumpPatch(double x0, double size, double height, std::uint16_t lines,
+                            std::uint32_t tolerance_q8 = 512) {
+  protocol::Command command;
+  command.type = protocol::MessageType::kPatch;
+  command.seq = 0;
+  protocol::PatchCommand& patch = command.body.patch;
+  patch.basis = Basis::kBezier;
+  patch.dims = 2;
+  patch.lines_s = lines;
+  patch.lines_t = lines;
+  patch.tolerance_q8 = tolerance_q8;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const double x = x0 + size * j / 3 + (i == 1 || i == 2 ? 0.3 * size * (j % 2) : 0.0);
+      const double y = x0 + size * i / 3 + ((i == 1 || i == 2) && (j == 1 || j == 2) ? height : 0);
+      patch.geometry[0].g[i][j] = GeometryFixed::FromRaw(std::llround(x * 65536));
+      patch.geometry[1].g[i][j] = GeometryFixed::FromRaw(std::llround(y * 65536));
+    }
+  }
+  return command;
+}
+
+// The exact point of a Bézier patch (geometry from the command) in long double.
+std::array<long double, 2> ExactBezier(const protocol::PatchCommand& patch, long double s,
+                                       long double t) {
+  const auto bernstein = [](long double u, int k) {
+    const long double v = 1 - u;
+    const long double b[4] = {v * v * v, 3 * u * v * v, 3 * u * u * v, u * u * u};
+    return b[k];
+  };
+  std::array<long double, 2> p{0, 0};
+  for (int a = 0; a < 2; ++a) {
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        p[a] += bernstein(s, i) * bernstein(t, j) * patch.geometry[a].g[i][j].Raw() / 65536.0L;
+      }
+    }
+  }
+  return p;
+}
+
+TEST(PathGenerator, PatchIsolinesAreStepExactAndWithinTheTolerance) {
+  const protocol::Command command = BumpPatch(100, 900, 250, 5, 3 * 256);
+  const protocol::PatchCommand& patch = command.body.patch;
+  uint8_t detail = 0;
+  ASSERT_EQ(motion::ValidateCommand<2>(command, Config(4000), &detail), protocol::ErrorCode::kNone);
+  motion::PathGenerator<2> generator;
+  const std::int32_t origin[2] = {0, 0};
+  generator.Reset(origin, false);
+  generator.Start(command);
+  std::array<long double, 2> position{0, 0};
+  bool pen = false;
+  std::vector<std::vector<std::array<long double, 2>>> strokes;
+  int done = 0;
+  std::uint8_t entry = 0;
+  while (generator.Next(&entry)) {
+    switch (motion::KindOf(entry)) {
+      case EntryKind::kPenDown:
+        ASSERT_FALSE(pen);
+        pen = true;
+        strokes.push_back({position});
+        break;
+      case EntryKind::kPenUp:
+        ASSERT_TRUE(pen);
+        pen = false;
+        break;
+      case EntryKind::kCommandDone:
+        ++done;
+        break;
+      case EntryKind::kMove:
+        for (int a = 0; a < 2; ++a) {
+          if ((entry >> (2 * a) & 1) != 0) position[a] += (entry >> (2 * a) & 2) != 0 ? -1 : 1;
+        }
+        if (pen) strokes.back().push_back(position);
+        break;
+    }
+  }
+  EXPECT_FALSE(generator.failed());
+  EXPECT_EQ(done, 1);
+  EXPECT_FALSE(pen);               // a patch ends with the pen up
+  ASSERT_EQ(strokes.size(), 10u);  // 5 s-lines, 5 t-lines
+  // Each stroke follows its isoline: s-lines first, every other one reversed.
+  const long double tolerance = patch.tolerance_q8 / 256.0L;
+  for (std::size_t k = 0; k < strokes.size(); ++k) {
+    const bool s_line = k < 5;
+    const long double fixed = (k % 5) / 4.0L;
+    const bool reversed = (k % 5) % 2 == 1;
+    const auto exact = [&](long double u) {
+      const long double along = reversed ? 1 - u : u;
+      return s_line ? ExactBezier(patch, fixed, along) : ExactBezier(patch, along, fixed);
+    };
+    const auto& stroke = strokes[k];
+    const auto start = exact(0);
+    const auto end = exact(1);
+    EXPECT_LE(std::fabs(stroke.front()[0] - start[0]), 0.5L);
+    EXPECT_LE(std::fabs(stroke.front()[1] - start[1]), 0.5L);
+    EXPECT_LE(std::fabs(stroke.back()[0] - end[0]), 0.5L);
+    EXPECT_LE(std::fabs(stroke.back()[1] - end[1]), 0.5L);
+    // Every chord within the tolerance of the curve: dense samples of the
+    // curve lie near the polyline, and every polyline vertex near the curve.
+    std::vector<std::array<long double, 2>> samples;
+    for (int i = 0; i <= 4000; ++i) samples.push_back(exact(i / 4000.0L));
+    for (const auto& p : stroke) {
+      long double best = 1e30L;
+      for (const auto& q : samples) best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1]));
+      EXPECT_LE(best, tolerance) << "stroke " << k;
+    }
+    for (std::size_t i = 1; i < stroke.size(); ++i) {
+      EXPECT_LE(std::fabs(stroke[i][0] - stroke[i - 1][0]), 1.0L);
+      EXPECT_LE(std::fabs(stroke[i][1] - stroke[i - 1][1]), 1.0L);
+    }
+  }
+}
+
+TEST(PathGenerator, MoveStepsThroughRoundedPointsOfTheStraightLine) {
+  motion::PathGenerator<2> generator;
+  const std::int32_t start[2] = {17, 5};
+  generator.Reset(start, true);
+  protocol::Command move;
+  move.type = protocol::MessageType::kMove;
+  move.body.move.target[0] = 1017;
+  move.body.move.target[1] = 382;
+  move.body.move.target[2] = 0;
+  generator.Start(move);
+  std::array<long double, 2> p{17, 5};
+  std::uint8_t entry = 0;
+  int moves = 0;
+  while (generator.Next(&entry)) {
+    if (motion::KindOf(entry) != EntryKind::kMove) continue;
+    ++moves;
+    for (int a = 0; a < 2; ++a) {
+      if ((entry >> (2 * a) & 1) != 0) p[a] += (entry >> (2 * a) & 2) != 0 ? -1 : 1;
+    }
+    // Each point is a point of the line 17 + 1000u, 5 + 377u with both
+    // coordinates rounded: u is within 0.5/1000 of (x − 17)/1000, so y is
+    // within 0.5 + 0.377·0.5 of the line at that u.
+    const long double u = (p[0] - 17) / 1000.0L;
+    EXPECT_LE(std::fabs(p[1] - (5 + 377 * u)), 0.5L + 0.377L * 0.5L + 1e-9L);
+  }
+  // x steps at most once a move; y's roundings sometimes change at other
+  // parameters than x's, which costs a move of its own.
+  EXPECT_GE(moves, 1000);
+  EXPECT_LE(moves, 1000 + 377);
+  EXPECT_EQ(p[0], 1017);
+  EXPECT_EQ(p[1], 382);
+}
+
+TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {
+  std::uint8_t detail = 0;
+  // Inside.
+  EXPECT_EQ(motion::ValidateCommand<2>(BumpPatch(100, 900, 250, 4), Config(4000), &detail),
+            protocol::ErrorCode::kNone);
+  // The bump pokes out at the top (y), though the corners are inside.
+  EXPECT_EQ(motion::ValidateCommand<2>(BumpPatch(100, 900, 3100, 4), Config(1500), &detail),
+            protocol::ErrorCode::kOutOfTravel);
+  EXPECT_EQ(detail, 1);
+  // A curve that dips below y = 0 is refused; one whose control points lie
+  // below 0 but whose curve stays above is accepted: the hull test alone
+  // would refuse it, the dry run of its points decides.
+  protocol::Command curve;
+  curve.type = protocol::MessageType::kCurve;
+  curve.body.curve.basis = Basis::kBezier;
+  curve.body.curve.dims = 2;
+  curve.body.curve.tolerance_q8 = 512;
+  const double xs[4] = {10, 400, 800, 1190};
+  const double ys[4] = {40, -40, -40, 40};  // the curve dips to y = -20: outside
+  for (int i = 0; i < 4; ++i) {
+    curve.body.curve.geometry[0].g[i] = GeometryFixed::FromRaw(std::llround(xs[i] * 65536));
+    curve.body.curve.geometry[1].g[i] = GeometryFixed::FromRaw(std::llround(ys[i] * 65536));
+  }
+  EXPECT_EQ(motion::ValidateCommand<2>(curve, Config(1200), &detail),
+            protocol::ErrorCode::kOutOfTravel);
+  EXPECT_EQ(detail, 1);
+  const double inside[4] = {40, -4, -4, 40};  // hull below 0, curve dips only to 13
+  for (int i = 0; i < 4; ++i) {
+    curve.body.curve.geometry[1].g[i] = GeometryFixed::FromRaw(std::llround(inside[i] * 65536));
+  }
+  EXPECT_EQ(motion::ValidateCommand<2>(curve, Config(1200), &detail), protocol::ErrorCode::kNone);
+  // A tolerance whole steps cannot meet.
+  EXPECT_EQ(motion::ValidateCommand<2>(BumpPatch(100, 900, 250, 4, 100), Config(4000), &detail),
+            protocol::ErrorCode::kPlannerRefused);
+  EXPECT_EQ(detail, static_cast<std::uint8_t>(Status::kToleranceUnreachable));
+  // Dimensions.
+  EXPECT_EQ(motion::ValidateCommand<3>(BumpPatch(100, 900, 250, 4), Config(4000), &detail),
+            protocol::ErrorCode::kDimsMismatch);
+  // Moves.
+  protocol::Command move;
+  move.type = protocol::MessageType::kMove;
+  move.body.move.target[0] = 1201;
+  move.body.move.target[1] = 0;
+  EXPECT_EQ(motion::ValidateCommand<2>(move, Config(1200), &detail),
+            protocol::ErrorCode::kOutOfTravel);
+  EXPECT_EQ(detail, 0);
+}
+
+// --- The device ------------------------------------------------------------
+
+class DeviceTest : public ::testing::Test {
+ protected:
+  using Device = device::Device<2, 4, 256>;
+  DeviceTest() : steps_(clock_, 2), pen_(clock_), device_(kTickHz) {}
+
+  protocol::ErrorCode Accept(const protocol::Command& command, std::uint8_t* detail) {
+    return device_.Accept(command, detail);
+  }
+  protocol::Command Configure(std::int32_t travel = 4000) {
+    protocol::Command command;
+    command.type = protocol::MessageType::kConfig;
+    command.body.config = Config(travel);
+    return command;
+  }
+  // Main loop and step timer until idle (or `limit` ticks).
+  void RunUntilIdle(std::uint64_t limit = 20'000'000) {
+    for (std::uint64_t t = 0; t < limit; ++t) {
+      device_.Fill();
+      ASSERT_EQ(device_.Tick(steps_, pen_), hal::IoStatus::kOk);
+      clock_.Advance(25);
+      if (device_.Idle()) return;
+    }
+    FAIL() << "not idle after " << limit << " ticks";
+  }
+  protocol::StatusReport Status() {
+    protocol::StatusReport report{};
+    device_.FillStatus(&report);
+    return report;
+  }
+
+  hal::SimClock clock_;
+  hal::SimStepDir steps_;
+  hal::SimPen pen_;
+  Device device_;
+};
+
+TEST_F(DeviceTest, RefusesMotionBeforeConfigurationAndConfigurationsItCannotServe) {
+  std::uint8_t detail = 0;
+  EXPECT_EQ(Accept(BumpPatch(100, 900, 250, 4), &detail), protocol::ErrorCode::kNotConfigured);
+  protocol::Command config = Configure();
+  config.body.config.axes = 3;
+  EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kDimsMismatch);
+  config = Configure();
+  config.body.config.max_rate = kTickHz + 1;
+  EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kBadField);
+  EXPECT_EQ(detail, protocol::kConfigFieldMaxRate);
+  config = Configure();
+  config.body.config.accel = 1;
+  EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kBadField);
+  EXPECT_EQ(detail, protocol::kConfigFieldAccel);
+  EXPECT_EQ(device_.Credits(), 4);  // nothing was queued
+}
+
+TEST_F(DeviceTest, ExecutesInOrderAndCountsEveryCommandOnce) {
+  std::uint8_t detail = 0;
+  ASSERT_EQ(Accept(Configure(), &detail), protocol::ErrorCode::kNone);
+  ASSERT_EQ(Accept(BumpPatch(100, 900, 250, 3), &detail), protocol::ErrorCode::kNone);
+  protocol::Command pen;
+  pen.type = protocol::MessageType::kPen;
+  pen.body.pen.down = true;
+  ASSERT_EQ(Accept(pen, &detail), protocol::ErrorCode::kNone);
+  protocol::Command move;
+  move.type = protocol::MessageType::kMove;
+  move.body.move.target[0] = 3000;
+  move.body.move.target[1] = 200;
+  move.body.move.target[2] = 0;
+  ASSERT_EQ(Accept(move, &detail), protocol::ErrorCode::kNone);
+  EXPECT_EQ(device_.Credits(), 0);
+  RunUntilIdle();
+  const protocol::StatusReport status = Status();
+  EXPECT_EQ(status.state, protocol::DeviceState::kIdle);
+  EXPECT_EQ(status.executed, 4u);  // config, patch, pen, move
+  EXPECT_EQ(status.position[0], 3000);
+  EXPECT_EQ(status.position[1], 200);
+  EXPECT_TRUE(status.pen_down);  // the last command put it down
+  EXPECT_EQ(steps_.position(0), 3000);
+  EXPECT_EQ(steps_.position(1), 200);
+}
+
+TEST_F(DeviceTest, StopDropsTheQueueComesToRestAndLiftsThePen) {
+  std::uint8_t detail = 0;
+  ASSERT_EQ(Accept(Configure(), &detail), protocol::ErrorCode::kNone);
+  ASSERT_EQ(Accept(BumpPatch(100, 900, 250, 6), &detail), protocol::ErrorCode::kNone);
+  ASSERT_EQ(Accept(BumpPatch(1200, 900, 250, 6), &detail), protocol::ErrorCode::kNone);
+  for (int t = 0; t < 200000; ++t) {  // 5 s: well into the first patch
+    device_.Fill();
+    device_.Tick(steps_, pen_);
+    clock_.Advance(25);
+  }
+  ASSERT_TRUE(pen_.down() || !pen_.events().empty());
+  device_.Stop();
+  EXPECT_EQ(Accept(BumpPatch(100, 900, 250, 3), &detail), protocol::ErrorCode::kStopped);
+  RunUntilIdle();
+  EXPECT_FALSE(pen_.down());
+  EXPECT_EQ(Status().state, protocol::DeviceState::kIdle);
+  EXPECT_EQ(Status().queued, 0);
+  // The stop kept the acceleration limit: the recorded motion passes the checks.
+  const sim::MotionReport report =
+      sim::CheckMotion(steps_.events(), pen_.events(), SiLimits(8000, 160000, 0.010));
+  EXPECT_EQ(report.violations, 0u) << report.first_violation;
+  // It accepts work again afterwards, from where it stopped.
+  ASSERT_EQ(Accept(BumpPatch(100, 900, 250, 3), &detail), protocol::ErrorCode::kNone);
+  RunUntilIdle();
+  EXPECT_EQ(Status().state, protocol::DeviceState::kIdle);
+}
+
+TEST_F(DeviceTest, AFailingOutputFaultsTheDevice) {
+  std::uint8_t detail = 0;
+  ASSERT_EQ(Accept(Configure(), &detail), protocol::ErrorCode::kNone);
+  ASSERT_EQ(Accept(BumpPatch(100, 900, 250, 3), &detail), protocol::ErrorCode::kNone);
+  for (int t = 0; t < 40000; ++t) {
+    device_.Fill();
+    device_.Tick(steps_, pen_);
+    clock_.Advance(25);
+  }
+  steps_.InjectError(hal::IoStatus::kIoError);
+  hal::IoStatus status = hal::IoStatus::kOk;
+  for (int t = 0; t < 1000 && status == hal::IoStatus::kOk; ++t) {
+    device_.Fill();
+    status = device_.Tick(steps_, pen_);
+  }
+  EXPECT_EQ(status, hal::IoStatus::kIoError);
+  const protocol::StatusReport report = Status();
+  EXPECT_EQ(report.state, protocol::DeviceState::kFault);
+  EXPECT_EQ(report.error, protocol::ErrorCode::kOutputFailed);
+  EXPECT_EQ(report.error_detail, static_cast<std::uint8_t>(hal::IoStatus::kIoError));
+  // Nothing moves after that.
+  const std::size_t events = steps_.events().size();
+  for (int t = 0; t < 1000; ++t) device_.Tick(steps_, pen_);
+  EXPECT_EQ(steps_.events().size(), events);
+}
+
+}  // namespace
+}  // namespace fdsurf

@@ -1,0 +1,228 @@
+// The simulated plotter end to end: the teapot streamed as patches to the
+// firmware running over the in-memory HAL, read back from the recorded pins
+// and compared with the double reference; the same through a link that
+// drops, corrupts, duplicates, reorders and truncates frames, and across an
+// unplug; and the checks themselves shown to fail on bad motion.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/stream.h"
+#include "fdsurf/sim/checks.h"
+#include "fdsurf/sim/plotter.h"
+
+namespace fdsurf::sim {
+namespace {
+
+const host::PatchSet& Teapot() {
+  static const host::PatchSet set =
+      host::ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/teapot.bpt");
+  return set;
+}
+
+// The teapot small and quick: 30×22 mm, 3×3 lines a patch, 0.0125 mm steps.
+host::StreamJob SmallTeapotJob(double accel = 2000, double speed = 150) {
+  host::ToolpathOptions options;
+  options.view = host::ParseView("iso");
+  options.fit = std::array<double, 2>{30, 22};
+  options.margin = 1;
+  options.lines_s = 3;
+  options.lines_t = 3;
+  options.tolerance = 0.02;
+  options.mode = host::StepMode::kStepExact;
+  host::MachineOptions machine;
+  machine.speed = speed;
+  machine.accel = accel;
+  machine.pen_delay_ms = 5;
+  return host::BuildStreamJob(Teapot(), options, machine, "mm");
+}
+
+struct Streamed {
+  RunResult result;
+  std::vector<DrawnPath> drawn;
+  std::vector<hal::StepDirEvent> steps;
+  std::vector<hal::PenEvent> pens;
+};
+
+Streamed Stream(const host::StreamJob& job, PlotterOptions options,
+                std::uint64_t unplug_at_us = 0) {
+  SimulatedPlotter plotter(options);
+  if (unplug_at_us != 0) plotter.ScheduleUnplug(unplug_at_us, unplug_at_us + 400'000);
+  host::HostLink link;
+  for (std::size_t k = 0; k < job.commands.size(); ++k) {
+    EXPECT_TRUE(link.Enqueue(job.commands[k], job.labels[k]).ok());
+  }
+  Streamed run;
+  run.result = plotter.Run(link, 3600ull * 1'000'000);
+  run.drawn = plotter.DrawnPaths();
+  run.steps = plotter.step_events();
+  run.pens = plotter.pen_events();
+  return run;
+}
+
+MotionLimitsSi LimitsOf(const host::StreamJob& job, std::uint32_t tick_hz = 40000) {
+  MotionLimitsSi limits;
+  limits.tick_hz = tick_hz;
+  limits.max_rate = job.config.max_rate;
+  limits.accel = job.config.accel;
+  limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
+  return limits;
+}
+
+std::vector<ReferenceLine> Reference(const host::StreamJob& job) {
+  std::vector<ReferenceLine> lines;
+  for (auto& points : host::ReferenceLines(Teapot(), job)) lines.push_back({std::move(points)});
+  return lines;
+}
+
+// The fault-free run, shared by the comparisons below.
+const Streamed& Baseline() {
+  static const Streamed run = Stream(SmallTeapotJob(), PlotterOptions{});
+  return run;
+}
+
+TEST(ReplayEvents, RebuildsPenDownStrokesFromPulses) {
+  const std::vector<hal::StepDirEvent> steps = {{10, 1, 0, true}, {20, 3, 2, true},
+                                                {30, 0, 2, true}, {40, 2, 2, true},
+                                                {50, 1, 1, true}, {60, 1, 0, true}};
+  const std::vector<hal::PenEvent> pens = {{15, true}, {45, false}, {55, true}};
+  const std::vector<DrawnPath> paths = ReplayEvents(steps, pens);
+  ASSERT_EQ(paths.size(), 2u);
+  // Down at (1,0): +x−y → (2,−1), −y → (2,−2); up; −x (pen up) → (1,−2); down; +x → (2,−2).
+  const std::vector<std::array<std::int64_t, 3>> first = {{1, 0, 0}, {2, -1, 0}, {2, -2, 0}};
+  const std::vector<std::array<std::int64_t, 3>> second = {{1, -2, 0}, {2, -2, 0}};
+  EXPECT_EQ(paths[0].points, first);
+  EXPECT_EQ(paths[1].points, second);
+}
+
+TEST(CheckMotion, CatchesEveryKindOfViolation) {
+  MotionLimitsSi limits;
+  limits.tick_hz = 40000;
+  limits.max_rate = 1000;
+  limits.accel = 10000;
+  limits.pen_delay_s = 0.01;
+  // A well-behaved run: steps 1 ms apart after a gentle start.
+  std::vector<hal::StepDirEvent> good;
+  double t = 0;
+  for (int i = 1; i <= 200; ++i) {
+    t += i < 20 ? 0.02 / i + 0.001 : 0.0011;
+    good.push_back({static_cast<std::uint64_t>(t * 1e6), 1, 0, true});
+  }
+  EXPECT_EQ(CheckMotion(good, {}, limits).violations, 0u);
+  // Two steps of one axis 0.5 ms apart: above 1000 steps/s.
+  auto fast = good;
+  fast[100].time_us = fast[99].time_us + 500;
+  EXPECT_GT(CheckMotion(fast, {}, limits).violations, 0u);
+  // Ten steps in the first 10 ms: a jump start.
+  std::vector<hal::StepDirEvent> jump;
+  for (int i = 0; i < 10; ++i)
+    jump.push_back({static_cast<std::uint64_t>(1000 * (i + 1)), 1, 0, true});
+  EXPECT_GT(CheckMotion(jump, {}, limits).violations, 0u);
+  // A step 2 ms after a pen change with a 10 ms pen delay.
+  const std::vector<hal::PenEvent> pen = {{good[150].time_us - 2000, true}};
+  EXPECT_GT(CheckMotion(good, pen, limits).violations, 0u);
+}
+
+TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {
+  const host::StreamJob job = SmallTeapotJob();
+  const Streamed& run = Baseline();
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  EXPECT_EQ(run.result.host.retransmitted, 0u);
+  const DrawingComparison comparison = CompareDrawing(run.drawn, Reference(job), 2);
+  // Every drawn point and chord near the exact curves, and no curve left out.
+  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
+  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
+  EXPECT_GT(comparison.drawn_points, 10000u);
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+  EXPECT_LE(motion.max_speed, job.config.max_rate * 1.01);
+  EXPECT_GT(motion.max_speed, job.config.max_rate * 0.9);  // and it does get up to speed
+}
+
+TEST(SimulatedPlotter, TheComparisonSeesADrawingThatIsOff) {
+  const host::StreamJob job = SmallTeapotJob();
+  std::vector<ReferenceLine> moved = Reference(job);
+  for (auto& line : moved) {
+    for (auto& p : line.points) p[0] += 3;  // 3 steps to the right
+  }
+  const DrawingComparison comparison = CompareDrawing(Baseline().drawn, moved, 2);
+  EXPECT_GT(comparison.max_deviation, job.tolerance_steps + 0.005);
+}
+
+TEST(SimulatedPlotter, TheLimitChecksSeeAMachineThatIsTooFast) {
+  // The device is configured for 4× the acceleration and 2× the speed; the
+  // checks hold it to the real machine's limits.
+  const host::StreamJob fast = SmallTeapotJob(8000, 300);
+  const Streamed run = Stream(fast, PlotterOptions{});
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  const MotionReport report = CheckMotion(run.steps, run.pens, LimitsOf(SmallTeapotJob()));
+  EXPECT_GT(report.violations, 0u);
+  EXPECT_EQ(CheckMotion(run.steps, run.pens, LimitsOf(fast)).violations, 0u);
+}
+
+struct FaultCase {
+  double rate;
+  std::uint64_t seed;
+};
+
+class FaultInjection : public ::testing::TestWithParam<FaultCase> {};
+
+TEST_P(FaultInjection, EveryPatchOnceInOrderAndTheSameDrawing) {
+  const host::StreamJob job = SmallTeapotJob();
+  PlotterOptions options;
+  options.to_device = FaultRates::All(GetParam().rate);
+  options.to_host = FaultRates::All(GetParam().rate);
+  options.fault_seed = GetParam().seed;
+  const Streamed run = Stream(job, options);
+  ASSERT_TRUE(run.result.finished) << run.result.error;  // never stuck
+  EXPECT_GT(run.result.faults_to_device.dropped + run.result.faults_to_device.corrupted +
+                run.result.faults_to_device.duplicated + run.result.faults_to_host.dropped,
+            0u);
+  // Exactly once: the device accepted each command once and executed each.
+  EXPECT_EQ(run.result.device.commands_accepted, job.commands.size());
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  // In order and complete: the very same drawing as without faults.
+  ASSERT_EQ(run.drawn.size(), Baseline().drawn.size());
+  for (std::size_t k = 0; k < run.drawn.size(); ++k) {
+    ASSERT_EQ(run.drawn[k].points, Baseline().drawn[k].points) << "stroke " << k;
+  }
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+  std::printf(
+      "faults %.0f%% seed %llu: %llu frames sent, %llu commands resent, %llu timeouts, "
+      "%llu NAKs; %.2f s machine time\n",
+      GetParam().rate * 100, static_cast<unsigned long long>(GetParam().seed),
+      static_cast<unsigned long long>(run.result.host.frames_sent),
+      static_cast<unsigned long long>(run.result.host.retransmitted),
+      static_cast<unsigned long long>(run.result.host.timeouts),
+      static_cast<unsigned long long>(run.result.host.naks), run.result.time_us * 1e-6);
+}
+
+INSTANTIATE_TEST_SUITE_P(Rates, FaultInjection,
+                         ::testing::Values(FaultCase{0.01, 1}, FaultCase{0.05, 2},
+                                           FaultCase{0.05, 3}, FaultCase{0.2, 4}),
+                         [](const ::testing::TestParamInfo<FaultCase>& info) {
+                           return "Percent" +
+                                  std::to_string(static_cast<int>(info.param.rate * 100)) + "Seed" +
+                                  std::to_string(info.param.seed);
+                         });
+
+TEST(SimulatedPlotter, ResumesAfterAnUnplugAndDrawsTheSame) {
+  const host::StreamJob job = SmallTeapotJob();
+  // Unplugged 50 ms in, while commands are still being sent, for 0.4 s.
+  const Streamed run = Stream(job, PlotterOptions{}, 50'000);
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  EXPECT_GE(run.result.device.hellos, 2u);  // the first handshake and the resume
+  ASSERT_EQ(run.drawn.size(), Baseline().drawn.size());
+  for (std::size_t k = 0; k < run.drawn.size(); ++k) {
+    ASSERT_EQ(run.drawn[k].points, Baseline().drawn[k].points) << "stroke " << k;
+  }
+}
+
+}  // namespace
+}  // namespace fdsurf::sim
