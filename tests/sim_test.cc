@@ -224,5 +224,70 @@ TEST(SimulatedPlotter, ResumesAfterAnUnplugAndDrawsTheSame) {
   }
 }
 
+TEST(SimulatedPlotter, CurvesMovesAndPenCommandsThroughTheLink) {
+  // A job by hand: travel, pen down, a Bézier curve, a straight move, pen up.
+  host::StreamJob job = SmallTeapotJob();
+  job.commands.resize(1);  // keep the CONFIG
+  job.labels.resize(1);
+  const auto add = [&](const protocol::Command& command, const char* label) {
+    job.commands.push_back(command);
+    job.labels.emplace_back(label);
+  };
+  protocol::Command move;
+  move.type = protocol::MessageType::kMove;
+  move.body.move.target[0] = 100;
+  move.body.move.target[1] = 100;
+  move.body.move.target[2] = 0;
+  add(move, "travel");
+  protocol::Command pen;
+  pen.type = protocol::MessageType::kPen;
+  pen.body.pen.down = true;
+  add(pen, "pen down");
+  protocol::Command curve;
+  curve.type = protocol::MessageType::kCurve;
+  curve.body.curve.basis = Basis::kBezier;
+  curve.body.curve.dims = 2;
+  curve.body.curve.tolerance_q8 = 2 * 256;
+  const double xs[4] = {100, 900, 1500, 2300};
+  const double ys[4] = {100, 1700, -300, 1200};
+  for (int i = 0; i < 4; ++i) {
+    curve.body.curve.geometry[0].g[i] = GeometryFixed::FromRaw(std::llround(xs[i] * 65536));
+    curve.body.curve.geometry[1].g[i] = GeometryFixed::FromRaw(std::llround(ys[i] * 65536));
+    curve.body.curve.geometry[2].g[i] = GeometryFixed::FromRaw(0);
+  }
+  add(curve, "curve");
+  move.body.move.target[0] = 2300;
+  move.body.move.target[1] = 200;
+  add(move, "line");
+  pen.body.pen.down = false;
+  add(pen, "pen up");
+  const Streamed run = Stream(job, PlotterOptions{});
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  // One pen-down stroke: the curve, then the line down to (2300, 200).
+  ASSERT_EQ(run.drawn.size(), 1u);
+  const auto& points = run.drawn[0].points;
+  EXPECT_EQ(points.front(), (std::array<std::int64_t, 3>{100, 100, 0}));
+  EXPECT_EQ(points.back(), (std::array<std::int64_t, 3>{2300, 200, 0}));
+  ReferenceLine exact;
+  for (int k = 0; k <= 20000; ++k) {
+    const double u = k / 20000.0;
+    const double b[4] = {(1 - u) * (1 - u) * (1 - u), 3 * u * (1 - u) * (1 - u), 3 * u * u * (1 - u),
+                         u * u * u};
+    std::array<double, 3> p{0, 0, 0};
+    for (int i = 0; i < 4; ++i) {
+      p[0] += b[i] * xs[i];
+      p[1] += b[i] * ys[i];
+    }
+    exact.points.push_back(p);
+  }
+  const ReferenceLine line{{{2300, 1200, 0}, {2300, 200, 0}}};
+  const DrawingComparison comparison = CompareDrawing(run.drawn, {exact, line}, 2);
+  EXPECT_LE(comparison.max_deviation, 2.0 + 0.01);  // the curve's tolerance: 2 steps
+  EXPECT_LE(comparison.max_gap, 2.0 + 0.01);
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+}
+
 }  // namespace
 }  // namespace fdsurf::sim

@@ -25,12 +25,6 @@
 namespace fdsurf::host {
 namespace {
 
-std::string Number(double v, int digits = 6) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*g", digits, v);
-  return text;
-}
-
 // Status queries four times a second: enough for the progress line and for
 // noticing the end, few enough to leave the link to the commands.
 HostLinkOptions LinkOptions() {
@@ -53,20 +47,32 @@ class ProgressLine {
   ProgressLine(const ProgressLine&) = delete;
   ProgressLine& operator=(const ProgressLine&) = delete;
 
+  /// Redraws at most 10 times a second (and always when `force`).
   void Show(std::uint64_t executed, std::uint64_t total, std::uint64_t frames,
-            double machine_seconds) {
+            double machine_seconds, bool force = false) {
     if (!enabled_) return;
-    const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
+    const auto now = Clock::now();
+    if (!force && shown_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
     const int percent = total == 0 ? 100 : static_cast<int>(executed * 100 / total);
     constexpr int kWidth = 24;
     std::string bar(kWidth, '.');
     for (int i = 0; i < percent * kWidth / 100; ++i) bar[static_cast<std::size_t>(i)] = '#';
-    std::fprintf(stderr,
-                 "\rfdsurf: [%s] %3d%%  commands %llu/%llu executed, %llu frames sent, "
-                 "%.1f s machine time (%.0f commands/s)   ",
+    // The simulator reports its machine time: show how much faster than
+    // real time it runs; a real device runs in real time, so show the rate.
+    char rate[64];
+    if (machine_seconds > 0) {
+      std::snprintf(rate, sizeof rate, "%.1f s machine time, %.0fx real time", machine_seconds,
+                    wall > 0 ? machine_seconds / wall : 0.0);
+    } else {
+      std::snprintf(rate, sizeof rate, "%.2f commands/s",
+                    wall > 0 ? static_cast<double>(executed) / wall : 0.0);
+    }
+    std::fprintf(stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
                  bar.c_str(), percent, static_cast<unsigned long long>(executed),
                  static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames),
-                 machine_seconds, wall > 0 ? static_cast<double>(executed) / wall : 0.0);
+                 rate);
     shown_ = true;
   }
   void Finish() {
@@ -79,6 +85,7 @@ class ProgressLine {
   bool enabled_;
   bool shown_ = false;
   Clock::time_point start_;
+  Clock::time_point last_;
 };
 
 ToolpathOptions DrawingOptions(const StreamOptions& o) {
@@ -187,7 +194,7 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
         progress.Show(p.executed, p.total, p.frames_sent, p.time_us * 1e-6);
       },
       250'000);
-  progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6);
+  progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6, true);
   progress.Finish();
   if (!run.finished) throw DeviceError("sim device: " + run.error);
 
