@@ -10,7 +10,8 @@ set(FDSURF_TARGET_ARCH arm)
 set(FDSURF_TARGET_SETUP ON)
 set(CMAKE_CXX_FLAGS_INIT
     "${FDSURF_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-unwind-tables -fno-asynchronous-unwind-tables")
-set(CMAKE_CXX_FLAGS_RELEASE_INIT "-O2")
+# Set, not _INIT: CMake would append its own -O3 to an _INIT value.
+set(CMAKE_CXX_FLAGS_RELEASE "-O2" CACHE STRING "Release flags of the target" FORCE)
 # No C runtime start files: targets/port/arm.cc has the vector table and reset
 # handler. newlib-nano provides memcpy/memset, libgcc the compiler helpers.
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${FDSURF_CPU_FLAGS} -nostdlib -Wl,--gc-sections")

@@ -13,7 +13,8 @@ set(FDSURF_TARGET_ARCH riscv)
 set(FDSURF_TARGET_SETUP ON)
 set(FDSURF_CPU_FLAGS "-march=rv32imac -mabi=ilp32 -mcmodel=medany")
 set(CMAKE_CXX_FLAGS_INIT "${FDSURF_CPU_FLAGS} -ffunction-sections -fdata-sections")
-set(CMAKE_CXX_FLAGS_RELEASE_INIT "-O2")
+# Set, not _INIT: CMake would append its own -O3 to an _INIT value.
+set(CMAKE_CXX_FLAGS_RELEASE "-O2" CACHE STRING "Release flags of the target" FORCE)
 # One RAM region holds code and data (QEMU loads the ELF into RAM): no RWX warning.
 set(CMAKE_EXE_LINKER_FLAGS_INIT
     "${FDSURF_CPU_FLAGS} -nostdlib -nostartfiles -Wl,--gc-sections -Wl,--no-warn-rwx-segments")

@@ -16,14 +16,14 @@ const int32_t kBenchControl[3][4] = {
     {0, 10000, 50000, 60000}, {0, 40000, 45000, 0}, {0, 5000, 15000, 20000}};
 
 void PutBenchLine(const char* name, int dims, uint32_t points, uint32_t acc_bits) {
-  PutString("bench ");
+  PutString(FDSURF_TEXT("bench "));
   PutString(name);
-  PutString(dims == 2 ? " 2d" : " 3d");
-  PutString(" points ");
+  PutString(dims == 2 ? FDSURF_TEXT(" 2d") : FDSURF_TEXT(" 3d"));
+  PutString(FDSURF_TEXT(" points "));
   PutUnsigned(points);
-  PutString(" acc ");
+  PutString(FDSURF_TEXT(" acc "));
   PutUnsigned(acc_bits);
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
 }
 
 template <int kDims>
@@ -41,6 +41,8 @@ void BenchEngineCurve(const char* name, const PreparedCurve<kDims>& curve) {
   PortMark();
   if (curve.format.acc_bits == 64) {
     CurveStepper<int64_t, kDims>(curve).ForEachPoint(Sink<kDims>());
+  } else if (!kImageWideAccumulators) {
+    PortExit(4);
   } else {
     CurveStepper<Int128, kDims>(curve).ForEachPoint(Sink<kDims>());
   }
@@ -53,30 +55,24 @@ void BenchEnginePatch(const PreparedPatch<kDims>& patch) {
   PortMark();
   if (patch.format.acc_bits == 64) {
     PatchStepper<int64_t, kDims>(patch).ForEachSLinePoint(Sink<kDims>());
+  } else if (!kImageWideAccumulators) {
+    PortExit(4);
   } else {
     PatchStepper<Int128, kDims>(patch).ForEachSLinePoint(Sink<kDims>());
   }
   PortMark();
-  PutBenchLine("engine-patch", kDims,
+  PutBenchLine(FDSURF_TEXT("engine-patch"), kDims,
                static_cast<uint32_t>(patch.steps_s + 1u) * (patch.steps_t + 1u),
                patch.format.acc_bits);
 }
 
 void BenchEngineAdaptive(const PreparedAdaptiveCurve<2>& curve) {
-  uint32_t points = 0;
-  const auto sink = [&points](uint32_t, const int32_t(&point)[2]) {
-    g_sink[0] = point[0];
-    g_sink[1] = point[1];
-    ++points;
-  };
+  // The same stepping function as the report, without digests: per point a
+  // store and a null-pointer test (report.cc).
   PortMark();
-  if (curve.format.acc_bits == 64) {
-    AdaptiveCurveStepper<int64_t, 2>(curve).ForEachPoint(sink);
-  } else {
-    AdaptiveCurveStepper<Int128, 2>(curve).ForEachPoint(sink);
-  }
+  const uint32_t points = StepAdaptive<2>(curve, nullptr, nullptr);
   PortMark();
-  PutBenchLine("engine-adaptive", 2, points, curve.format.acc_bits);
+  PutBenchLine(FDSURF_TEXT("engine-adaptive"), 2, points, curve.format.acc_bits);
 }
 
 // --- The alternatives, as a firmware author would write them. ---
@@ -105,7 +101,7 @@ void BenchDeCasteljau() {
     }
   }
   PortMark();
-  PutBenchLine("float-de-casteljau", kDims, kBenchSteps + 1u, 0);
+  PutBenchLine(FDSURF_TEXT("float-de-casteljau"), kDims, kBenchSteps + 1u, 0);
 }
 
 // Horner's rule in float on power coefficients formed once.
@@ -131,7 +127,7 @@ void BenchFloatHorner() {
     }
   }
   PortMark();
-  PutBenchLine("float-horner", kDims, kBenchSteps + 1u, 0);
+  PutBenchLine(FDSURF_TEXT("float-horner"), kDims, kBenchSteps + 1u, 0);
 }
 
 // Horner's rule in fixed point: power coefficients in quanta with 16
@@ -162,7 +158,7 @@ void BenchFixedHorner() {
     }
   }
   PortMark();
-  PutBenchLine("fixed-horner", kDims, kBenchSteps + 1u, 64);
+  PutBenchLine(FDSURF_TEXT("fixed-horner"), kDims, kBenchSteps + 1u, 64);
 }
 
 }  // namespace
@@ -177,7 +173,6 @@ int64_t BenchControlRaw(int coordinate, int k, bool wide) {
 void SetupBenchCurve2(bool wide, PreparedCurve<2>* out) {
   CurveGeometry1 geometry[2];
   BenchCurveGeometry(wide, geometry);
-  *out = PreparedCurve<2>{};
   const uint16_t steps = wide ? kBenchWideSteps : kBenchSteps;
   if (PrepareCurve(geometry, Basis::kBezier, steps, PrepareOptions(), out) != Status::kOk) {
     PortExit(3);
@@ -187,7 +182,6 @@ void SetupBenchCurve2(bool wide, PreparedCurve<2>* out) {
 void SetupBenchCurve3(PreparedCurve<3>* out) {
   CurveGeometry1 geometry[3];
   BenchCurveGeometry(false, geometry);
-  *out = PreparedCurve<3>{};
   if (PrepareCurve(geometry, Basis::kBezier, kBenchSteps, PrepareOptions(), out) != Status::kOk) {
     PortExit(3);
   }
@@ -201,7 +195,6 @@ void SetupBenchPatch(PreparedPatch<kDims>* out) {
       geometry[c].g[k / 4][k % 4] = GeometryFixed::FromRaw(TeapotRaw(kBenchTeapotPatch, c, k));
     }
   }
-  *out = PreparedPatch<kDims>{};
   if (PreparePatch(geometry, Basis::kBezier, kBenchGrid, kBenchGrid, PrepareOptions(), out) !=
       Status::kOk) {
     PortExit(3);
@@ -217,7 +210,6 @@ void SetupBenchAdaptive2(PreparedAdaptiveCurve<2>* out) {
   PowerCurve1 power[2];
   AdaptiveSettings settings;
   settings.tolerance_q8 = 50 * 256;  // 0.05 mm at Q = 1 µm
-  *out = PreparedAdaptiveCurve<2>{};
   if (CurvePowerCoefficients(geometry, Basis::kBezier, power) != Status::kOk ||
       PrepareAdaptiveCurve(power, settings, out) != Status::kOk) {
     PortExit(3);
@@ -226,55 +218,89 @@ void SetupBenchAdaptive2(PreparedAdaptiveCurve<2>* out) {
 
 #endif  // FDSURF_IMAGE_SETUP
 
+// The table under measurement lives here rather than on the stack: the
+// set-up below it needs about 6 KB of stack on AVR, and the ATmega2560 has
+// 8 KB of RAM for everything.
+union BenchTable {
+  PreparedCurve<2> curve2;
+  PreparedCurve<3> curve3;
+  PreparedPatch<2> patch2;
+#if FDSURF_IMAGE_SETUP
+  PreparedPatch<3> patch3;
+#endif
+  PreparedAdaptiveCurve<2> adaptive2;
+  BenchTable() : curve2() {}
+};
+BenchTable g_table;
+#if FDSURF_IMAGE_SETUP
+__attribute__((noinline)) void BenchSetup() {
+  // Set-up cost: one patch and one curve from geometry to table.
+  PreparedPatch<3>& patch = g_table.patch3;
+  PortMark();
+  SetupBenchPatch3(&patch);
+  PortMark();
+  PutBenchLine(FDSURF_TEXT("setup-patch"), 3, 1, patch.format.acc_bits);
+  PreparedCurve<2>& curve = g_table.curve2;
+  PortMark();
+  SetupBenchCurve2(false, &curve);
+  PortMark();
+  PutBenchLine(FDSURF_TEXT("setup-curve"), 2, 1, curve.format.acc_bits);
+}
+#endif
+
+__attribute__((noinline)) void BenchCurves2(const BenchSource& source) {
+  PreparedCurve<2>& curve = g_table.curve2;
+  source.curve2(false, &curve);
+  BenchEngineCurve(FDSURF_TEXT("engine-curve"), curve);
+  BenchDeCasteljau<2>();
+  BenchFloatHorner<2>();
+  BenchFixedHorner<2>();
+  if (source.wide) {
+    source.curve2(true, &curve);
+    BenchEngineCurve(FDSURF_TEXT("engine-curve-wide"), curve);
+  }
+}
+
+__attribute__((noinline)) void BenchCurves3(const BenchSource& source) {
+  PreparedCurve<3>& curve = g_table.curve3;
+  source.curve3(&curve);
+  BenchEngineCurve(FDSURF_TEXT("engine-curve"), curve);
+  BenchDeCasteljau<3>();
+  BenchFloatHorner<3>();
+  BenchFixedHorner<3>();
+}
+
+__attribute__((noinline)) void BenchPatch2(const BenchSource& source) {
+  PreparedPatch<2>& patch = g_table.patch2;
+  source.patch2(&patch);
+  BenchEnginePatch(patch);
+}
+
+#if FDSURF_IMAGE_SETUP
+__attribute__((noinline)) void BenchPatch3(const BenchSource& source) {
+  PreparedPatch<3>& patch = g_table.patch3;
+  source.patch3(&patch);
+  BenchEnginePatch(patch);
+}
+#endif
+
+__attribute__((noinline)) void BenchAdaptive(const BenchSource& source) {
+  PreparedAdaptiveCurve<2>& curve = g_table.adaptive2;
+  source.adaptive2(&curve);
+  BenchEngineAdaptive(curve);
+}
+
 void RunBench(const BenchSource& source) {
 #if FDSURF_IMAGE_SETUP
-  if (source.measure_setup) {
-    // Set-up cost: one patch and one curve from geometry to table.
-    PreparedPatch<3> patch;
-    PortMark();
-    SetupBenchPatch3(&patch);
-    PortMark();
-    PutBenchLine("setup-patch", 3, 1, patch.format.acc_bits);
-    PreparedCurve<2> curve;
-    PortMark();
-    SetupBenchCurve2(false, &curve);
-    PortMark();
-    PutBenchLine("setup-curve", 2, 1, curve.format.acc_bits);
-  }
+  if (source.measure_setup) BenchSetup();
 #endif
-  {
-    PreparedCurve<2> curve;
-    source.curve2(false, &curve);
-    BenchEngineCurve("engine-curve", curve);
-    BenchDeCasteljau<2>();
-    BenchFloatHorner<2>();
-    BenchFixedHorner<2>();
-    source.curve2(true, &curve);
-    BenchEngineCurve("engine-curve-wide", curve);
-  }
-  {
-    PreparedCurve<3> curve;
-    source.curve3(&curve);
-    BenchEngineCurve("engine-curve", curve);
-    BenchDeCasteljau<3>();
-    BenchFloatHorner<3>();
-    BenchFixedHorner<3>();
-  }
-  {
-    PreparedPatch<2> patch;
-    source.patch2(&patch);
-    BenchEnginePatch(patch);
-  }
-  if (source.patch3 != nullptr) {
-    PreparedPatch<3> patch;
-    source.patch3(&patch);
-    BenchEnginePatch(patch);
-  }
-  {
-    PreparedAdaptiveCurve<2> curve;
-    source.adaptive2(&curve);
-    BenchEngineAdaptive(curve);
-  }
+  BenchCurves2(source);
+  BenchCurves3(source);
+  BenchPatch2(source);
+#if FDSURF_IMAGE_SETUP
+  if (source.patch3 != nullptr) BenchPatch3(source);
+#endif
+  BenchAdaptive(source);
 }
 
 }  // namespace image

@@ -47,6 +47,8 @@ struct BenchSource {
   void (*patch3)(PreparedPatch<3>* out);  // nullptr: not on this target
   void (*adaptive2)(PreparedAdaptiveCurve<2>* out);
   bool measure_setup;
+  /// Whether to measure the 128-bit accumulator (the wide curve).
+  bool wide;
 };
 
 /// Runs every measured loop and prints its bench line.

@@ -38,65 +38,75 @@ void RunRomCases(Reporter& reporter) {
     switch (item.kind) {
       case RomKind::kPatch2:
         Load(kRomPatch2[item.index], &g_rom.patch2);
-        reporter.Patch(true, g_rom.patch2.name, g_rom.patch2.index, g_rom.patch2.status,
+        reporter.Patch(true, kRomPatch2[item.index].name, g_rom.patch2.index, g_rom.patch2.status,
                        g_rom.patch2.prepared);
         break;
       case RomKind::kCurve2:
         Load(kRomCurve2[item.index], &g_rom.curve2);
-        reporter.Curve(true, g_rom.curve2.name, g_rom.curve2.index, g_rom.curve2.status,
+        reporter.Curve(true, kRomCurve2[item.index].name, g_rom.curve2.index, g_rom.curve2.status,
                        g_rom.curve2.prepared);
         break;
       case RomKind::kCurve3:
         Load(kRomCurve3[item.index], &g_rom.curve3);
-        reporter.Curve(true, g_rom.curve3.name, g_rom.curve3.index, g_rom.curve3.status,
+        reporter.Curve(true, kRomCurve3[item.index].name, g_rom.curve3.index, g_rom.curve3.status,
                        g_rom.curve3.prepared);
         break;
       case RomKind::kAdaptive2:
         Load(kRomAdaptive2[item.index], &g_rom.adaptive2);
-        reporter.Adaptive(true, g_rom.adaptive2.name, g_rom.adaptive2.index, g_rom.adaptive2.status,
-                          g_rom.adaptive2.prepared);
+        reporter.Adaptive(true, kRomAdaptive2[item.index].name, g_rom.adaptive2.index,
+                          g_rom.adaptive2.status, g_rom.adaptive2.prepared);
         break;
       case RomKind::kCoefficients2:
         Load(kRomCoefficients2[item.index], &g_rom.coefficients2);
-        reporter.Coefficients(true, g_rom.coefficients2.name, g_rom.coefficients2.index,
+        reporter.Coefficients(true, kRomCoefficients2[item.index].name, g_rom.coefficients2.index,
                               g_rom.coefficients2.curve);
         break;
     }
   }
 }
 
-void RomCurve2(bool wide, PreparedCurve<2>* out) { Load(kRomBenchCurve2[wide ? 1 : 0], out); }
-void RomCurve3(PreparedCurve<3>* out) { Load(kRomBenchCurve3, out); }
-void RomPatch2(PreparedPatch<2>* out) { Load(kRomBenchPatch2, out); }
-void RomAdaptive2(PreparedAdaptiveCurve<2>* out) { Load(kRomBenchAdaptive2, out); }
+void LoadBenchCurve2(bool wide, PreparedCurve<2>* out) { Load(kRomBenchCurve2[wide ? 1 : 0], out); }
+void LoadBenchCurve3(PreparedCurve<3>* out) { Load(kRomBenchCurve3, out); }
+void LoadBenchPatch2(PreparedPatch<2>* out) { Load(kRomBenchPatch2, out); }
+void LoadBenchAdaptive2(PreparedAdaptiveCurve<2>* out) { Load(kRomBenchAdaptive2, out); }
 #endif
 
 }  // namespace
 
 int RunImage(bool small_only) {
-  PutString("fdsurf test image 1\n");
+  PutString(FDSURF_TEXT("fdsurf test image 1\n"));
   Reporter reporter;
 #if FDSURF_IMAGE_SETUP
   reporter.small_only = small_only;
   RunCases(reporter);
-  BenchSource source = {SetupBenchCurve2, SetupBenchCurve3,    SetupBenchPatch2,
-                        SetupBenchPatch3, SetupBenchAdaptive2, true};
+  PutString(FDSURF_TEXT("# stack-after-cases "));
+  PutUnsigned(PortStackUsed());
+  PutString(FDSURF_TEXT("\n"));
+  BenchSource source = {SetupBenchCurve2,
+                        SetupBenchCurve3,
+                        SetupBenchPatch2,
+                        SetupBenchPatch3,
+                        SetupBenchAdaptive2,
+                        true,
+                        true};
   if (small_only) {
     source.patch3 = nullptr;
     source.measure_setup = false;
+    source.wide = false;
   }
 #else
   static_cast<void>(small_only);
   RunRomCases(reporter);
-  const BenchSource source = {RomCurve2, RomCurve3, RomPatch2, nullptr, RomAdaptive2, false};
+  const BenchSource source = {
+      LoadBenchCurve2, LoadBenchCurve3, LoadBenchPatch2, nullptr, LoadBenchAdaptive2, false, false};
 #endif
   RunBench(source);
-  PutString("end\n");
+  PutString(FDSURF_TEXT("end\n"));
   // Lines starting with '#' describe the target, not the results: the
   // comparison with the host leaves them out.
-  PutString("# stack ");
+  PutString(FDSURF_TEXT("# stack "));
   PutUnsigned(PortStackUsed());
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
   return 0;
 }
 

@@ -10,8 +10,12 @@
 #include <avr/pgmspace.h>
 // Tables live in flash on AVR; reading them goes through PortReadRom.
 #define FDSURF_IMAGE_ROM PROGMEM
+// A string literal in flash on AVR (2 KB of RAM on the ATmega328P); read it
+// with PutString (targets/image/report.h).
+#define FDSURF_TEXT(literal) PSTR(literal)
 #else
 #define FDSURF_IMAGE_ROM
+#define FDSURF_TEXT(literal) (literal)
 #endif
 
 namespace fdsurf {

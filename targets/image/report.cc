@@ -3,8 +3,20 @@
 namespace fdsurf {
 namespace image {
 
+// kCrcNibbleTable[n] is the CRC-32 (polynomial 0xEDB88320) of the nibble n
+// shifted through four steps of the bitwise algorithm.
+const uint32_t kCrcNibbleTable[16] = {0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu,
+                                      0x76DC4190u, 0x6B6B51F4u, 0x4DB26158u, 0x5005713Cu,
+                                      0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+                                      0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu};
+
 void PutString(const char* text) {
-  while (*text != '\0') PortPutChar(*text++);
+  for (;;) {
+    char c;
+    PortReadRom(&c, text++, 1);
+    if (c == '\0') return;
+    PortPutChar(c);
+  }
 }
 
 void PutUnsigned(uint32_t value) {
@@ -28,29 +40,32 @@ void PutDecimal(int32_t value) {
 
 void PutHex(uint32_t value) {
   for (int shift = 28; shift >= 0; shift -= 4) {
-    PortPutChar("0123456789abcdef"[(value >> shift) & 0xFu]);
+    const uint8_t nibble = static_cast<uint8_t>((value >> shift) & 0xFu);
+    PortPutChar(static_cast<char>(nibble < 10 ? '0' + nibble : 'a' + nibble - 10));
   }
 }
 
 void PutItemHead(const char* kind, const char* name, uint16_t index, Status status,
                  const DiffFormat& format) {
   PutString(kind);
-  PutString(" ");
+  PutString(FDSURF_TEXT(" "));
   PutString(name);
-  PutString("-");
+  PutString(FDSURF_TEXT("-"));
   PutUnsigned(index);
-  PutString(status == Status::kOk ? " ok" : " refused ");
+  PutString(status == Status::kOk ? FDSURF_TEXT(" ok") : FDSURF_TEXT(" refused "));
   if (status != Status::kOk) {
     PutUnsigned(static_cast<uint32_t>(status));
     return;
   }
-  PutString(" acc ");
+  PutString(FDSURF_TEXT(" acc "));
   PutUnsigned(format.acc_bits);
-  PutString(" frac ");
+  PutString(FDSURF_TEXT(" frac "));
   PutUnsigned(format.frac_bits);
 }
 
 namespace {
+
+volatile int32_t g_adaptive_sink[3];
 
 template <typename Acc, int kDims>
 void DigestPatch(const PreparedPatch<kDims>& patch) {
@@ -62,7 +77,7 @@ void DigestPatch(const PreparedPatch<kDims>& patch) {
   stepper.ForEachTLinePoint(
       [&t_lines](uint32_t, uint32_t, const int32_t(&point)[kDims]) { t_lines.Add(point); });
   s_lines.Put();
-  PutString(" tlines");
+  PutString(FDSURF_TEXT(" tlines"));
   t_lines.Put();
 }
 
@@ -74,81 +89,110 @@ void DigestCurve(const PreparedCurve<kDims>& curve) {
   digest.Put();
 }
 
-template <typename Acc, int kDims>
+template <int kDims>
 void DigestAdaptive(const PreparedAdaptiveCurve<kDims>& curve) {
   PointDigest<kDims> digest;
-  // The parameter positions are part of the result too: fold them in as a
-  // further "coordinate" digest.
+  // The parameter positions are part of the result too: a further digest.
   PointDigest<1> positions;
-  AdaptiveCurveStepper<Acc, kDims>(curve).ForEachPoint(
-      [&digest, &positions](uint32_t position, const int32_t(&point)[kDims]) {
-        digest.Add(point);
-        const int32_t p[1] = {static_cast<int32_t>(position)};
-        positions.Add(p);
-      });
+  StepAdaptive(curve, &digest, &positions);
   digest.Put();
-  PutString(" positions");
+  PutString(FDSURF_TEXT(" positions"));
   positions.Put();
 }
 
+// What the adaptive stepper calls per point: a store that cannot be
+// optimized away and, for the report, the digests.
+template <int kDims>
+struct AdaptiveSink {
+  PointDigest<kDims>* points;
+  PointDigest<1>* positions;
+  uint32_t count;
+  void operator()(uint32_t position, const int32_t (&point)[kDims]) {
+    for (int c = 0; c < kDims; ++c) g_adaptive_sink[c] = point[c];
+    ++count;
+    if (points != nullptr) {
+      points->Add(point);
+      const int32_t p[1] = {static_cast<int32_t>(position)};
+      positions->Add(p);
+    }
+  }
+};
+
 }  // namespace
+
+template <int kDims>
+uint32_t StepAdaptive(const PreparedAdaptiveCurve<kDims>& curve, PointDigest<kDims>* points,
+                      PointDigest<1>* positions) {
+  AdaptiveSink<kDims> sink{points, positions, 0};
+  if (curve.format.acc_bits == 64) {
+    AdaptiveCurveStepper<int64_t, kDims>(curve).ForEachPoint(sink);
+  } else if (kImageWideAccumulators) {
+    AdaptiveCurveStepper<Int128, kDims>(curve).ForEachPoint(sink);
+  } else {
+    PortExit(4);
+  }
+  return sink.count;
+}
 
 template <int kDims>
 void Reporter::Patch(bool small, const char* name, uint16_t index, Status status,
                      const PreparedPatch<kDims>& patch) {
   if (small_only && !small) return;
-  PutItemHead(kDims == 2 ? "patch2" : "patch3", name, index, status, patch.format);
+  PutItemHead(kDims == 2 ? FDSURF_TEXT("patch2") : FDSURF_TEXT("patch3"), name, index, status,
+              patch.format);
   if (status == Status::kOk) {
-    PutString(patch.exact ? " exact" : " rounded");
+    PutString(patch.exact ? FDSURF_TEXT(" exact") : FDSURF_TEXT(" rounded"));
     if (patch.format.acc_bits == 64) {
       DigestPatch<int64_t>(patch);
-    } else {
+    } else if (kImageWideAccumulators) {
       DigestPatch<Int128>(patch);
+    } else {
+      PortExit(4);
     }
   }
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
 }
 
 template <int kDims>
 void Reporter::Curve(bool small, const char* name, uint16_t index, Status status,
                      const PreparedCurve<kDims>& curve) {
   if (small_only && !small) return;
-  PutItemHead(kDims == 2 ? "curve2" : "curve3", name, index, status, curve.format);
+  PutItemHead(kDims == 2 ? FDSURF_TEXT("curve2") : FDSURF_TEXT("curve3"), name, index, status,
+              curve.format);
   if (status == Status::kOk) {
-    PutString(curve.exact ? " exact" : " rounded");
+    PutString(curve.exact ? FDSURF_TEXT(" exact") : FDSURF_TEXT(" rounded"));
     if (curve.format.acc_bits == 64) {
       DigestCurve<int64_t>(curve);
-    } else {
+    } else if (kImageWideAccumulators) {
       DigestCurve<Int128>(curve);
+    } else {
+      PortExit(4);
     }
   }
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
 }
 
 template <int kDims>
 void Reporter::Adaptive(bool small, const char* name, uint16_t index, Status status,
                         const PreparedAdaptiveCurve<kDims>& curve) {
   if (small_only && !small) return;
-  PutItemHead(kDims == 2 ? "adaptive2" : "adaptive3", name, index, status, curve.format);
+  PutItemHead(kDims == 2 ? FDSURF_TEXT("adaptive2") : FDSURF_TEXT("adaptive3"), name, index, status,
+              curve.format);
   if (status == Status::kOk) {
-    PutString(" level ");
+    PutString(FDSURF_TEXT(" level "));
     PutUnsigned(curve.finest_level);
-    if (curve.format.acc_bits == 64) {
-      DigestAdaptive<int64_t>(curve);
-    } else {
-      DigestAdaptive<Int128>(curve);
-    }
+    DigestAdaptive(curve);
   }
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
 }
 
 template <int kDims>
 void Reporter::Coefficients(bool small, const char* name, uint16_t index,
                             const PowerCurve1 (&curve)[kDims]) {
   if (small_only && !small) return;
-  PutString("coefficients ");
+  PutString(FDSURF_TEXT("coefficients "));
   PutString(name);
-  PutString("-");
+  PutString(FDSURF_TEXT("-"));
   PutUnsigned(index);
   PointDigest<1> digest;
   for (int c = 0; c < kDims; ++c) {
@@ -161,10 +205,14 @@ void Reporter::Coefficients(bool small, const char* name, uint16_t index,
     }
   }
   digest.Put();
-  PutString("\n");
+  PutString(FDSURF_TEXT("\n"));
 }
 
 // Unused instantiations are dropped by --gc-sections on the targets.
+template uint32_t StepAdaptive<2>(const PreparedAdaptiveCurve<2>&, PointDigest<2>*,
+                                  PointDigest<1>*);
+template uint32_t StepAdaptive<3>(const PreparedAdaptiveCurve<3>&, PointDigest<3>*,
+                                  PointDigest<1>*);
 template void Reporter::Patch<2>(bool, const char*, uint16_t, Status, const PreparedPatch<2>&);
 template void Reporter::Patch<3>(bool, const char*, uint16_t, Status, const PreparedPatch<3>&);
 template void Reporter::Curve<2>(bool, const char*, uint16_t, Status, const PreparedCurve<2>&);

@@ -9,17 +9,32 @@
 #include "fdsurf/forward_difference.h"
 #include "port.h"
 
+#ifndef FDSURF_IMAGE_ACC64_ONLY
+#define FDSURF_IMAGE_ACC64_ONLY 0
+#endif
+
 namespace fdsurf {
 namespace image {
 
+/// Whether the image steps 128-bit tables. The ATmega328P image does not:
+/// its host-prepared tables all fit 64-bit accumulators (as
+/// PrepareOptions::max_acc_bits = 64 would ensure on a device), and the
+/// 128-bit steppers would not fit its flash beside them.
+constexpr bool kImageWideAccumulators = FDSURF_IMAGE_ACC64_ONLY == 0;
+
+/// Prints a FDSURF_TEXT string (in flash on AVR).
 void PutString(const char* text);
 void PutDecimal(int32_t value);
 void PutUnsigned(uint32_t value);
 void PutHex(uint32_t value);
 
-/// CRC-32 (IEEE 802.3, reflected, bitwise: no table to spend flash on) over
-/// the little-endian bytes of every coordinate of every point, plus the point
-/// count and the first and last point as a readable sample.
+/// The 16-entry table of a nibble-wise CRC-32: 64 bytes, and a quarter of
+/// the bitwise loop's work on an 8-bit core.
+extern const uint32_t kCrcNibbleTable[16];
+
+/// CRC-32 (IEEE 802.3, reflected) over the little-endian bytes of every
+/// coordinate of every point, plus the point count and the first and last
+/// point as a readable sample.
 template <int kDims>
 class PointDigest {
  public:
@@ -35,18 +50,18 @@ class PointDigest {
 
   /// " points N crc X first x y [z] last x y [z]"
   void Put() const {
-    PutString(" points ");
+    PutString(FDSURF_TEXT(" points "));
     PutUnsigned(count_);
-    PutString(" crc ");
+    PutString(FDSURF_TEXT(" crc "));
     PutHex(~crc_);
-    PutString(" first");
+    PutString(FDSURF_TEXT(" first"));
     for (int c = 0; c < kDims; ++c) {
-      PutString(" ");
+      PutString(FDSURF_TEXT(" "));
       PutDecimal(count_ != 0 ? first_[c] : 0);
     }
-    PutString(" last");
+    PutString(FDSURF_TEXT(" last"));
     for (int c = 0; c < kDims; ++c) {
-      PutString(" ");
+      PutString(FDSURF_TEXT(" "));
       PutDecimal(count_ != 0 ? last_[c] : 0);
     }
   }
@@ -54,7 +69,8 @@ class PointDigest {
  private:
   void AddByte(uint8_t byte) {
     crc_ ^= byte;
-    for (int bit = 0; bit < 8; ++bit) crc_ = (crc_ >> 1) ^ (0xEDB88320u & (0u - (crc_ & 1u)));
+    crc_ = (crc_ >> 4) ^ kCrcNibbleTable[crc_ & 0xFu];
+    crc_ = (crc_ >> 4) ^ kCrcNibbleTable[crc_ & 0xFu];
   }
 
   uint32_t crc_ = 0xFFFFFFFFu;
@@ -63,6 +79,15 @@ class PointDigest {
   int32_t last_[kDims] = {};
 };
 
+/// Steps an adaptive curve with the accumulator its format names and returns
+/// the number of points; with digests, digests the points and their
+/// parameter positions. Shared by the report and the bench (which passes
+/// nullptr), so that small flash holds one copy of the adaptive stepper.
+template <int kDims>
+uint32_t StepAdaptive(const PreparedAdaptiveCurve<kDims>& curve, PointDigest<kDims>* points,
+                      PointDigest<1>* positions);
+
+/// Names passed to the Reporter are FDSURF_TEXT strings too.
 /// Prints one line per prepared item: its name, the status of its set-up, the
 /// planner's format, and the digest of every point the stepper emits.
 class Reporter {

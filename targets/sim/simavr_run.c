@@ -23,12 +23,13 @@
 enum { kMarkAddress = 0x4A, kExitAddress = 0x4B };
 
 static FILE* g_marks;
+static FILE* g_uart; /* the real stdout; simavr's own messages go to stderr */
 static int g_exit_status = -1;
 
 static void OnUartByte(struct avr_irq_t* irq, uint32_t value, void* param) {
   (void)irq;
   (void)param;
-  putchar((int)(value & 0xFF));
+  fputc((int)(value & 0xFF), g_uart);
 }
 
 static void OnMark(struct avr_t* avr, avr_io_addr_t addr, uint8_t v, void* param) {
@@ -73,6 +74,14 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: fdsurf_simavr -m MCU [-f HZ] [-o MARKS] [-c MAX_CYCLES] IMAGE.elf\n");
     return 2;
   }
+  /* libsimavr prints progress ("Loaded ... .text") on stdout: keep stdout for
+   * the UART and send everything else to stderr. */
+  fflush(stdout);
+  g_uart = fdopen(dup(STDOUT_FILENO), "w");
+  if (g_uart == NULL || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) {
+    perror("fdsurf_simavr");
+    return 2;
+  }
   elf_firmware_t firmware;
   memset(&firmware, 0, sizeof firmware);
   if (elf_read_firmware(argv[optind], &firmware) != 0) {
@@ -107,7 +116,7 @@ int main(int argc, char** argv) {
     state = avr_run(avr);
     if (state == cpu_Done || state == cpu_Crashed) break;
   }
-  fflush(stdout);
+  fclose(g_uart);
   if (g_marks != NULL) fclose(g_marks);
   fprintf(stderr, "fdsurf_simavr: %s, %llu cycles\n", mcu, (unsigned long long)avr->cycle);
   if (g_exit_status >= 0) return g_exit_status;

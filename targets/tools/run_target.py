@@ -147,7 +147,7 @@ def main():
     if len(counts) != 2 * len(bench):
         sys.exit(f"{args.target}: {len(counts)} marks for {len(bench)} bench lines")
     unit = "cycles" if args.target in AVR else "instructions"
-    stack = [line.split()[2] for line in actual.splitlines() if line.startswith("# stack")]
+    stack = [line.split()[2] for line in actual.splitlines() if line.startswith("# stack ")]
     with open(os.path.join(results, "bench.tsv"), "w") as out:
         out.write(f"# target\tname\tdims\tpoints\tacc\t{unit}\tper point\n")
         for i, fields in enumerate(bench):
