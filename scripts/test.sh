@@ -6,8 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
-echo "== build (Release) and test"
+echo "== build (Release) and test, with every microcontroller image under its emulator"
 bash scripts/setup.sh
+# Includes the Target.* tests: each builds a cross target in build/targets/<target>
+# and runs its image under QEMU or simavr against the host reference.
 ctest --test-dir build --output-on-failure --parallel "$jobs"
 
 echo "== build with -fsanitize=address,undefined and test"

@@ -75,6 +75,33 @@ void BenchEngineAdaptive(const PreparedAdaptiveCurve<2>& curve) {
   PutBenchLine(FDSURF_TEXT("engine-adaptive"), 2, points, curve.format.acc_bits);
 }
 
+// Where the engine's time goes, for the 2-D curve: the row-add update
+// alone, and the rounding to whole quanta alone, per point (the engine's own
+// inline functions, on the same table).
+__attribute__((noinline)) void BenchEngineParts(const PreparedCurve<2>& curve) {
+  if (curve.format.acc_bits != 64) return;
+  int64_t d[2][4];
+  for (int c = 0; c < 2; ++c) {
+    for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d[c][k]);
+  }
+  PortMark();
+  for (uint16_t i = 0; i <= curve.steps; ++i) {
+    for (int c = 0; c < 2; ++c) {
+      internal::Step(d[c]);
+      g_sink[c] = static_cast<int32_t>(d[c][0]);
+    }
+  }
+  PortMark();
+  PutBenchLine(FDSURF_TEXT("engine-step-only"), 2, curve.steps + 1u, 64);
+  const int frac_bits = curve.format.frac_bits;
+  PortMark();
+  for (uint16_t i = 0; i <= curve.steps; ++i) {
+    for (int c = 0; c < 2; ++c) g_sink[c] = RoundToQuanta(d[c][0] + i, frac_bits);
+  }
+  PortMark();
+  PutBenchLine(FDSURF_TEXT("engine-round-only"), 2, curve.steps + 1u, 64);
+}
+
 // --- The alternatives, as a firmware author would write them. ---
 
 inline int32_t RoundFloat(float x) { return static_cast<int32_t>(x >= 0.0f ? x + 0.5f : x - 0.5f); }
@@ -252,6 +279,7 @@ __attribute__((noinline)) void BenchCurves2(const BenchSource& source) {
   PreparedCurve<2>& curve = g_table.curve2;
   source.curve2(false, &curve);
   BenchEngineCurve(FDSURF_TEXT("engine-curve"), curve);
+  BenchEngineParts(curve);
   BenchDeCasteljau<2>();
   BenchFloatHorner<2>();
   BenchFixedHorner<2>();

@@ -34,7 +34,10 @@ std::string Int128Text(const Int128& v) {
 }
 
 std::string FormatText(const DiffFormat& f) {
-  return "{" + std::to_string(f.acc_bits) + ", " + std::to_string(f.frac_bits) + "}";
+  char text[32];
+  std::snprintf(text, sizeof text, "{%u, %u}", static_cast<unsigned>(f.acc_bits),
+                static_cast<unsigned>(f.frac_bits));
+  return text;
 }
 
 std::string Int64Text(int64_t v) {
@@ -47,8 +50,10 @@ std::string Int64Text(int64_t v) {
 
 template <int kDims>
 std::string Text(const PreparedPatch<kDims>& p) {
-  std::string s = "{" + FormatText(p.format) + ", " + std::to_string(p.steps_s) + ", " +
-                  std::to_string(p.steps_t) + ", " + (p.exact ? "true" : "false") + ", {";
+  // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) on "{" + string.
+  std::string s = "{";
+  s += FormatText(p.format) + ", " + std::to_string(p.steps_s) + ", " + std::to_string(p.steps_t) +
+       ", " + (p.exact ? "true" : "false") + ", {";
   for (int c = 0; c < kDims; ++c) {
     s += "{";
     for (int k = 0; k < 4; ++k) {
@@ -63,8 +68,9 @@ std::string Text(const PreparedPatch<kDims>& p) {
 
 template <int kDims>
 std::string Text(const PreparedCurve<kDims>& p) {
-  std::string s = "{" + FormatText(p.format) + ", " + std::to_string(p.steps) + ", " +
-                  (p.exact ? "true" : "false") + ", {";
+  std::string s = "{";
+  s += FormatText(p.format) + ", " + std::to_string(p.steps) + ", " + (p.exact ? "true" : "false") +
+       ", {";
   for (int c = 0; c < kDims; ++c) {
     s += "{";
     for (int k = 0; k < 4; ++k) s += Int128Text(p.d[c][k]) + ", ";
@@ -75,9 +81,9 @@ std::string Text(const PreparedCurve<kDims>& p) {
 
 template <int kDims>
 std::string Text(const PreparedAdaptiveCurve<kDims>& p) {
-  std::string s = "{" + FormatText(p.format) + ", " + std::to_string(p.finest_level) +
-                  ", static_cast<AdaptiveMode>(" + std::to_string(static_cast<int>(p.mode)) +
-                  "), {";
+  std::string s = "{";
+  s += FormatText(p.format) + ", " + std::to_string(p.finest_level) +
+       ", static_cast<AdaptiveMode>(" + std::to_string(static_cast<int>(p.mode)) + "), {";
   for (int c = 0; c < kDims; ++c) {
     s += "{";
     for (int k = 0; k < 4; ++k) s += Int128Text(p.d[c][k]) + ", ";
