@@ -21,10 +21,10 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 echo "== clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
 
-echo "== clang-tidy (firmware/, host/)"
+echo "== clang-tidy (firmware/, host/, the test image's host build)"
 # clang-tidy counts the (filtered-out) warnings of system headers on stderr;
 # show its output only when it fails.
-if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' |
+if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'targets/image/*.cc' 'targets/port/host.cc' |
   xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
   echo "$tidy" | grep -v 'warnings generated'
   exit 1
