@@ -119,15 +119,23 @@ def main():
     p.add_argument("--host", required=True)
     p.add_argument("--plugin", required=True)
     p.add_argument("--simavr", required=True)
+    p.add_argument("--self-test", action="store_true",
+                   help="change one digit of the host's report and pass only if the comparison "
+                        "then fails (the check of the check)")
     args = p.parse_args()
 
     build = os.path.join(args.dir, "targets")
     elf = os.path.join(build, "fdsurf_image.elf")
-    results = os.path.join(args.dir, "results")
+    results = os.path.join(args.dir, "results-self-test" if args.self_test else "results")
     os.makedirs(results, exist_ok=True)
 
     host_args = [args.host] + (["--small"] if args.target == "atmega328p" else [])
     expected = subprocess.run(host_args, check=True, capture_output=True, text=True).stdout
+    if args.self_test:
+        # The last digit of the first CRC.
+        at = expected.index(" crc ") + len(" crc ") + 7
+        flipped = "0" if expected[at] != "0" else "1"
+        expected = expected[:at] + flipped + expected[at + 1:]
     actual, counts = run_image(args, elf, results)
 
     def compared(text):
@@ -137,7 +145,12 @@ def main():
         diff = difflib.unified_diff(compared(expected), compared(actual), "host", args.target,
                                     lineterm="", n=1)
         print("\n".join(list(diff)[:60]))
+        if args.self_test:
+            print(f"{args.target}: one changed digit in the reference is caught, as it must be")
+            return
         sys.exit(f"{args.target}: the report differs from the host reference")
+    if args.self_test:
+        sys.exit(f"{args.target}: a changed reference went unnoticed")
     lines = compared(actual)
     items = sum(1 for line in lines if line.split()[0] in
                 ("patch2", "patch3", "curve2", "curve3", "adaptive2", "adaptive3", "coefficients"))
