@@ -13,6 +13,13 @@ packages=(
   libcairo2-dev
   libusb-1.0-0-dev libgpiod-dev gpiod
   python3 hp2xx librsvg2-bin
+  # Microcontroller images under emulation (targets/README.md): the cross
+  # compilers, QEMU (Cortex-M, RV32) and simavr with its library (AVR).
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
+  gcc-riscv64-unknown-elf
+  gcc-avr avr-libc binutils-avr
+  qemu-system-arm qemu-system-misc
+  simavr libsimavr-dev libelf-dev
 )
 # The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.
 # Debian's nodejs + npm provide node; a machine that already has a node with

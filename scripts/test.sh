@@ -6,8 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
-echo "== build (Release) and test"
+echo "== build (Release) and test, with every microcontroller image under its emulator"
 bash scripts/setup.sh
+# Includes the Target.* tests: each builds a cross target in build/targets/<target>
+# and runs its image under QEMU or simavr against the host reference.
 ctest --test-dir build --output-on-failure --parallel "$jobs"
 
 echo "== build with -fsanitize=address,undefined and test"
@@ -19,10 +21,11 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 echo "== clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
 
-echo "== clang-tidy (firmware/, host/, hal/, sim/)"
+echo "== clang-tidy (firmware/, host/, hal/, sim/, the test image's host build)"
 # clang-tidy counts the (filtered-out) warnings of system headers on stderr;
 # show its output only when it fails.
-if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' |
+if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'targets/image/*.cc' \
+  'targets/port/host.cc' |
   xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
   echo "$tidy" | grep -v 'warnings generated'
   exit 1

@@ -1,0 +1,116 @@
+#!/usr/bin/env python3
+"""Prints the microcontroller tables of docs/performance.md from the results
+of the emulator runs (ctest --test-dir build -L targets writes them to
+build/targets/<target>/results/).
+
+Usage: python3 targets/tools/report.py [BUILD_DIR]
+"""
+import os
+import sys
+
+TARGETS = ["atmega328p", "atmega2560", "cortex-m0", "cortex-m3", "cortex-m4f", "cortex-m7",
+           "rv32imac"]
+CLOCK_AVR = 16_000_000
+ALTERNATIVES = ["float-de-casteljau", "float-horner", "fixed-horner"]
+
+
+def read_tsv(path):
+    rows = []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            rows.append(line.rstrip("\n").split("\t"))
+    return rows
+
+
+def load(build):
+    bench, sizes = {}, {}
+    for target in TARGETS:
+        results = os.path.join(build, "targets", target, "results")
+        if not os.path.exists(os.path.join(results, "bench.tsv")):
+            continue
+        for t, name, dims, points, acc, count, _ in read_tsv(os.path.join(results, "bench.tsv")):
+            bench[(t, name, dims)] = (int(points), int(acc), int(count))
+        for t, group, text, data, bss, stack in read_tsv(os.path.join(results, "sizes.tsv")):
+            sizes[(t, group)] = (int(text), int(data), int(bss), stack)
+    return bench, sizes
+
+
+def per_point(bench, target, name, dims):
+    value = bench.get((target, name, dims))
+    return None if value is None else value[2] / value[0]
+
+
+def fmt(x, digits=0):
+    return "–" if x is None else f"{x:,.{digits}f}"
+
+
+def main():
+    build = sys.argv[1] if len(sys.argv) > 1 else "build"
+    bench, sizes = load(build)
+    present = [t for t in TARGETS if any(k[0] == t for k in bench)]
+
+    print("### AVR at 16 MHz: exact cycles per point (simavr)\n")
+    print("| chip | output | engine | float de Casteljau | float Horner | fixed Horner "
+          "| engine points/s | vs de Casteljau | vs float Horner | vs fixed Horner |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for t in [t for t in present if t.startswith("atmega")]:
+        for dims in ("2d", "3d"):
+            e = per_point(bench, t, "engine-curve", dims)
+            alts = [per_point(bench, t, a, dims) for a in ALTERNATIVES]
+            print(f"| {t} | {dims} curve | {fmt(e)} | " + " | ".join(fmt(a) for a in alts)
+                  + f" | {fmt(CLOCK_AVR / e)} | "
+                  + " | ".join(f"{fmt(a / e, 2)}×" for a in alts) + " |")
+    print()
+    print("| chip | engine row | points | accumulator | cycles/point | points/s |")
+    print("|---|---|---|---|---|---|")
+    for t in [t for t in present if t.startswith("atmega")]:
+        for (tt, name, dims), (points, acc, count) in sorted(bench.items()):
+            if tt != t or not (name.startswith("engine") or name.startswith("setup")):
+                continue
+            cpp = count / points
+            rate = "–" if name.startswith("setup") else fmt(CLOCK_AVR / cpp)
+            unit = "per item" if name.startswith("setup") else ""
+            print(f"| {t} | {name} {dims} {unit} | {points} | {acc}-bit | {fmt(cpp)} | {rate} |")
+    print()
+
+    print("### Cortex-M and RV32: guest instructions per point (QEMU plugin)\n")
+    print("| target | output | engine | float de Casteljau | float Horner | fixed Horner "
+          "| vs de Casteljau | vs float Horner | vs fixed Horner |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for t in [t for t in present if not t.startswith("atmega")]:
+        for dims in ("2d", "3d"):
+            e = per_point(bench, t, "engine-curve", dims)
+            alts = [per_point(bench, t, a, dims) for a in ALTERNATIVES]
+            print(f"| {t} | {dims} curve | {fmt(e, 1)} | "
+                  + " | ".join(fmt(a, 1) for a in alts) + " | "
+                  + " | ".join(f"{fmt(a / e, 2)}×" for a in alts) + " |")
+    print()
+    print("| target | 2-D patch | 3-D patch | 2-D adaptive | 2-D curve, 128-bit | set-up, 3-D patch 16×16 "
+          "| set-up, 2-D curve |")
+    print("|---|---|---|---|---|---|---|")
+    for t in present:
+        row = [per_point(bench, t, "engine-patch", "2d"), per_point(bench, t, "engine-patch", "3d"),
+               per_point(bench, t, "engine-adaptive", "2d"),
+               per_point(bench, t, "engine-curve-wide", "2d"),
+               per_point(bench, t, "setup-patch", "3d"), per_point(bench, t, "setup-curve", "2d")]
+        unit = "cycles" if t.startswith("atmega") else "instructions"
+        print(f"| {t} ({unit}) | " + " | ".join(fmt(x, 0 if t.startswith('atmega') else 1)
+                                               for x in row) + " |")
+    print()
+
+    print("### Flash and RAM (bytes)\n")
+    print("| target | engine: set-up + stepping (flash / static RAM) | stepping only (flash) "
+          "| test image flash | test image RAM: data + bss | test image stack high-water |")
+    print("|---|---|---|---|---|---|")
+    for t in present:
+        eng = sizes.get((t, "engine"))
+        step = sizes.get((t, "stepping"))
+        img = sizes.get((t, "test-image"))
+        eng_text = "does not fit" if eng is None else f"{eng[0] + eng[1]:,} / {eng[1]}"
+        print(f"| {t} | {eng_text} | {step[0] + step[1]:,} | {img[0] + img[1]:,} | "
+              f"{img[1] + img[2]:,} | {img[3]} |")
+
+
+main()
