@@ -273,8 +273,8 @@ TEST(SimulatedPlotter, CurvesMovesAndPenCommandsThroughTheLink) {
   ReferenceLine exact;
   for (int k = 0; k <= 20000; ++k) {
     const double u = k / 20000.0;
-    const double b[4] = {(1 - u) * (1 - u) * (1 - u), 3 * u * (1 - u) * (1 - u), 3 * u * u * (1 - u),
-                         u * u * u};
+    const double b[4] = {(1 - u) * (1 - u) * (1 - u), 3 * u * (1 - u) * (1 - u),
+                         3 * u * u * (1 - u), u * u * u};
     std::array<double, 3> p{0, 0, 0};
     for (int i = 0; i < 4; ++i) {
       p[0] += b[i] * xs[i];

@@ -69,10 +69,10 @@ class ProgressLine {
       std::snprintf(rate, sizeof rate, "%.2f commands/s",
                     wall > 0 ? static_cast<double>(executed) / wall : 0.0);
     }
-    std::fprintf(stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
-                 bar.c_str(), percent, static_cast<unsigned long long>(executed),
-                 static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames),
-                 rate);
+    std::fprintf(
+        stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
+        bar.c_str(), percent, static_cast<unsigned long long>(executed),
+        static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate);
     shown_ = true;
   }
   void Finish() {

@@ -5,8 +5,8 @@
 // (2 axes, 4 queued commands, a 256-entry lookahead), driven through the HAL
 // interfaces by a main loop. The device object is static, so its RAM shows
 // in .bss; the stack its set-up needs does not.
-#include "../image/image.h"
 #include "fdsurf/device/device.h"
+#include "../image/image.h"
 
 // A pure virtual function is never called here (every HAL class below
 // overrides all of them); the abstract bases' vtables still name it.
