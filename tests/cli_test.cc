@@ -242,7 +242,8 @@ TEST_F(Cli, PlotWritesEachFormat) {
 TEST_F(Cli, StreamDrawsOnTheSimulatedPlotterAndReports) {
   const std::string svg = (dir_ / "drawn.svg").string();
   const std::string png = (dir_ / "drawn.png").string();
-  const RunResult r = Run("stream '" + kTeapot + "' --fit 40x30 --lines 3 --pen-delay 5 --svg '" +
+  const RunResult r = Run("stream '" + kTeapot +
+                          "' --fit 24x18 --lines 3 --speed 250 --accel 5000 --pen-delay 5 --svg '" +
                           svg + "' --png '" + png + "' --size 300");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "");
@@ -254,7 +255,8 @@ TEST_F(Cli, StreamDrawsOnTheSimulatedPlotterAndReports) {
   EXPECT_EQ(Slurp(png).substr(1, 3), "PNG");
   // Through a lossy link: the same result, with retransmissions reported.
   const RunResult lossy =
-      Run("stream '" + kTeapot + "' --fit 40x30 --lines 3 --pen-delay 5 --faults 0.05 --seed 9");
+      Run("stream '" + kTeapot +
+          "' --fit 24x18 --lines 3 --speed 250 --accel 5000 --pen-delay 5 --faults 0.05 --seed 9");
   ASSERT_EQ(lossy.exit_code, 0) << lossy.err;
   EXPECT_NE(lossy.err.find("(--tolerance): within"), std::string::npos) << lossy.err;
   EXPECT_EQ(lossy.err.find(" 0 resent"), std::string::npos) << lossy.err;

@@ -235,6 +235,7 @@ protocol::Command BumpPatch(double x0, double size, double height, std::uint16_t
   command.type = protocol::MessageType::kPatch;
   command.seq = 0;
   protocol::PatchCommand& patch = command.body.patch;
+  patch = protocol::PatchCommand{};
   patch.basis = Basis::kBezier;
   patch.dims = 2;
   patch.lines_s = lines;
@@ -340,6 +341,26 @@ TEST(PathGenerator, PatchIsolinesAreStepExactAndWithinTheTolerance) {
       EXPECT_LE(std::fabs(stroke[i][0] - stroke[i - 1][0]), 1.0L);
       EXPECT_LE(std::fabs(stroke[i][1] - stroke[i - 1][1]), 1.0L);
     }
+  }
+}
+
+TEST(PathGenerator, LeavesOutTheEdgesAnotherPatchDraws) {
+  for (const std::uint8_t skip : {0, 1, 2, 4, 8, 5, 15}) {
+    protocol::Command command = BumpPatch(100, 900, 250, 4);
+    command.body.patch.skip_lines = skip;
+    std::uint8_t detail = 0;
+    ASSERT_EQ(motion::ValidateCommand<2>(command, Config(4000), &detail),
+              protocol::ErrorCode::kNone);
+    motion::PathGenerator<2> generator;
+    const std::int32_t origin[2] = {0, 0};
+    generator.Reset(origin, false);
+    generator.Start(command);
+    int strokes = 0;
+    std::uint8_t entry = 0;
+    while (generator.Next(&entry)) strokes += motion::KindOf(entry) == EntryKind::kPenDown ? 1 : 0;
+    int skipped = 0;
+    for (int bit = 0; bit < 4; ++bit) skipped += (skip >> bit) & 1;
+    EXPECT_EQ(strokes, 8 - skipped) << "skip_lines " << int{skip};
   }
 }
 

@@ -69,6 +69,7 @@ Command Patch(uint8_t dims, uint64_t salt) {
   p.lines_s = 9;
   p.lines_t = 0;
   p.tolerance_q8 = 13;
+  p.skip_lines = static_cast<uint8_t>(salt & kSkipLinesMask);
   std::mt19937_64 rng(salt);
   for (int a = 0; a < dims; ++a) {
     for (auto& row : p.geometry[a].g) {
@@ -172,8 +173,8 @@ TEST(Codec, TeapotSizedPatchIsCompact) {
       c.body.patch.geometry[1].g[i][j] = GeometryFixed::FromRaw(-(int64_t{1} << 29) + i);
     }
   }
-  EXPECT_EQ(CommandBody(c).size(), 10u + 32u * 5u);
-  EXPECT_EQ(Wire(c).size(), 10u + 32u * 5u + kFrameOverheadBytes + 2u);  // docs/protocol.md: 179
+  EXPECT_EQ(CommandBody(c).size(), 11u + 32u * 5u);
+  EXPECT_EQ(Wire(c).size(), 11u + 32u * 5u + kFrameOverheadBytes + 2u);  // docs/protocol.md: 180
 }
 
 TEST(Codec, UnusedGeometryIsZeroedAndNotSent) {
@@ -248,6 +249,7 @@ TEST(CodecValidation, Patch) {
   ExpectRefused(with([](PatchCommand* p) { p->lines_t = 0xFFFF; }), bad, kPatchFieldLinesT);
   ExpectRefused(with([](PatchCommand* p) { p->lines_s = p->lines_t = 0; }), bad, kPatchFieldLinesS);
   ExpectRefused(with([](PatchCommand* p) { p->tolerance_q8 = 0; }), bad, kPatchFieldTolerance);
+  ExpectRefused(with([](PatchCommand* p) { p->skip_lines = 0x10; }), bad, kPatchFieldSkipLines);
   for (int a = 0; a < 3; ++a) {
     for (int k = 0; k < 16; ++k) {
       for (int64_t v : {kGeometryLimitRaw, -kGeometryLimitRaw, INT64_MAX, INT64_MIN}) {
@@ -324,7 +326,7 @@ TEST(CodecValidation, ExactLength) {
   const DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
   EXPECT_EQ(r.field, kConfigFieldPenDelay);
-  const Bytes patch_cut = {2, 2, 2, 0, 0, 0, 1, 0, 0, 0, 5};  // one of 32 geometry values
+  const Bytes patch_cut = {2, 2, 2, 0, 0, 0, 1, 0, 0, 0, 0, 5};  // one of 32 geometry values
   const DecodeResult p = DecodeCommand(BodyFrame(MessageType::kPatch, patch_cut), &out);
   EXPECT_EQ(p.code, ErrorCode::kBadLength);
   EXPECT_EQ(p.field, kPatchFieldGeometry + 1);

@@ -129,6 +129,9 @@ TEST(CheckMotion, CatchesEveryKindOfViolation) {
 
 TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {
   const host::StreamJob job = SmallTeapotJob();
+  // The teapot's patches share edges; each is drawn once (the gap check below
+  // shows that none went missing).
+  EXPECT_EQ(job.shared_edges_skipped, 52u);
   const Streamed& run = Baseline();
   ASSERT_TRUE(run.result.finished) << run.result.error;
   EXPECT_EQ(run.result.executed, job.commands.size());

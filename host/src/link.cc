@@ -60,8 +60,8 @@ std::string FieldName(MessageType type, uint8_t index) {
       break;
     }
     case MessageType::kPatch: {
-      const std::array<const char*, 5> head = {"basis", "dims", "lines_s", "lines_t",
-                                               "tolerance_q8"};
+      const std::array<const char*, 6> head = {"basis",   "dims",         "lines_s",
+                                               "lines_t", "tolerance_q8", "skip_lines"};
       if (index < p::kPatchFieldGeometry) {
         return head[index];
       }

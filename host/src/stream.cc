@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/patch_io.h"
@@ -44,6 +45,33 @@ std::array<Vec, 2> Ends(const Patch& patch, const StreamJob& job, int lines_s, i
   }
   const bool reversed = ((lines_s - 1) & 1) != 0;
   return {start, InSteps(patch, job, 1, reversed ? 0 : 1)};
+}
+
+// An edge line a patch draws (s-line at s = 0 or 1, t-line at t = 0 or 1),
+// sampled at 9 parameters.
+using EdgeSamples = std::array<Vec, 9>;
+
+EdgeSamples SampleEdge(const Patch& patch, const StreamJob& job, int edge) {
+  EdgeSamples samples;
+  const double fixed = edge % 2 == 0 ? 0.0 : 1.0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const double u = static_cast<double>(k) / (samples.size() - 1);
+    samples[k] = edge < 2 ? InSteps(patch, job, fixed, u) : InSteps(patch, job, u, fixed);
+  }
+  return samples;
+}
+
+// Two patches that share an edge have the same control points along it, so
+// the samples agree (up to rounding), forwards or backwards.
+bool SameCurve(const EdgeSamples& a, const EdgeSamples& b) {
+  constexpr double kSame = 0.1;  // steps
+  bool forward = true;
+  bool backward = true;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    forward = forward && Distance(a[k], b[k]) <= kSame;
+    backward = backward && Distance(a[k], b[a.size() - 1 - k]) <= kSame;
+  }
+  return forward || backward;
 }
 
 std::int32_t ToSteps(double length, const Quantum& step, const std::string& what) {
@@ -123,6 +151,18 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   std::vector<std::array<Vec, 2>> ends(n);
   for (std::size_t p = 0; p < n; ++p) ends[p] = Ends(set.patches[p], job, t.lines_s, t.lines_t);
   std::vector<bool> done(n, false);
+  // Edges drawn so far, found by their rounded end points.
+  std::multimap<std::array<std::int64_t, 6>, EdgeSamples> drawn_edges;
+  const auto edge_key = [](const EdgeSamples& e) {
+    std::array<std::int64_t, 3> a{};
+    std::array<std::int64_t, 3> b{};
+    for (int c = 0; c < 3; ++c) {
+      a[c] = std::llround(e.front()[static_cast<std::size_t>(c)]);
+      b[c] = std::llround(e.back()[static_cast<std::size_t>(c)]);
+    }
+    if (b < a) std::swap(a, b);
+    return std::array<std::int64_t, 6>{a[0], a[1], a[2], b[0], b[1], b[2]};
+  };
   Vec pen{0, 0, 0};
   for (std::size_t k = 0; k < n; ++k) {
     std::size_t best = 0;
@@ -150,6 +190,28 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     body.tolerance_q8 = job.tolerance_q8;
     for (auto& axis : body.geometry) axis = PatchGeometry1{};
     PatchToQuanta(patch, job.page.map, machine.step, t.dims, body.geometry);
+    body.skip_lines = 0;
+    const std::uint8_t bits[4] = {protocol::kSkipFirstSLine, protocol::kSkipLastSLine,
+                                  protocol::kSkipFirstTLine, protocol::kSkipLastTLine};
+    for (int edge = 0; edge < 4; ++edge) {
+      if ((edge < 2 ? t.lines_s : t.lines_t) < 2) continue;
+      const EdgeSamples samples = SampleEdge(patch, job, edge);
+      if (Distance(samples.front(), samples.back()) < 1e-9 &&
+          Distance(samples.front(), samples[samples.size() / 2]) < 1e-9) {
+        continue;  // a pole: the device leaves it out anyway
+      }
+      const auto key = edge_key(samples);
+      bool shared = false;
+      for (auto [it, end] = drawn_edges.equal_range(key); it != end && !shared; ++it) {
+        shared = SameCurve(it->second, samples);
+      }
+      if (shared) {
+        body.skip_lines = static_cast<std::uint8_t>(body.skip_lines | bits[edge]);
+        ++job.shared_edges_skipped;
+      } else {
+        drawn_edges.emplace(key, samples);
+      }
+    }
     job.commands.push_back(command);
     job.labels.push_back("patch " + std::to_string(best) + " (" + patch.origin + ")");
     job.patches.push_back(StreamedPatch{best, t.lines_s, t.lines_t});

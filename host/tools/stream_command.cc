@@ -233,8 +233,10 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
     const std::size_t command_bytes = CommandBytes(job);
     const std::size_t gcode_bytes = GcodeBytes(set, drawing, units);
     std::fprintf(stderr,
-                 "%s: %zu patches streamed to the simulated plotter (%u axes, %u Hz ticks)\n",
-                 o.file.c_str(), job.patches.size(), plotter_options.axes, plotter_options.tick_hz);
+                 "%s: %zu patches streamed to the simulated plotter (%u axes, %u Hz ticks); %zu "
+                 "shared edges drawn once\n",
+                 o.file.c_str(), job.patches.size(), plotter_options.axes, plotter_options.tick_hz,
+                 job.shared_edges_skipped);
     std::fprintf(stderr,
                  "link: %llu frames sent (%llu commands, %llu resent), %llu bytes to the device, "
                  "%llu NAKs, %llu timeouts; all acknowledged after %.2f s\n",

@@ -29,6 +29,17 @@ int32_t StartOf(const PowerCurve1& axis) {
   return internal::ToInt32(static_cast<uint32_t>(floor));
 }
 
+// Whether line `index` of `lines` in a family is an edge the command says
+// another patch draws.
+bool Skipped(uint8_t skip_lines, IsolineFamily family, uint16_t index, uint16_t lines) {
+  const uint8_t first =
+      family == IsolineFamily::kSLines ? protocol::kSkipFirstSLine : protocol::kSkipFirstTLine;
+  const uint8_t last =
+      family == IsolineFamily::kSLines ? protocol::kSkipLastSLine : protocol::kSkipLastTLine;
+  return (index == 0 && (skip_lines & first) != 0) ||
+         (index + 1u == lines && (skip_lines & last) != 0);
+}
+
 template <int kDims>
 bool IsPoint(const PowerCurve1 (&curve)[kDims]) {
   for (int c = 0; c < kDims; ++c) {
@@ -116,7 +127,7 @@ ErrorCode CheckFamily(const PatchGeometry1 (&geometry)[kDims], const protocol::P
   }
   PowerCurve1 curve[kDims];
   for (uint16_t index = 0; walker.Next(curve); ++index) {
-    if (IsPoint(curve)) continue;  // not drawn
+    if (IsPoint(curve) || Skipped(patch.skip_lines, family, index, lines)) continue;  // not drawn
     if ((index & 1u) != 0) ReverseCurve(curve);
     const ErrorCode error = CheckLine(curve, patch.tolerance_q8, config, detail);
     if (error != ErrorCode::kNone) return error;
@@ -361,7 +372,9 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {
           continue;
         }
         const uint16_t index = line_index_++;
-        if (IsPoint(line_)) continue;  // a line collapsed to a point (a pole) draws nothing
+        // A line collapsed to a point (a pole) draws nothing; an edge another
+        // patch draws is left to it.
+        if (IsPoint(line_) || Skipped(patch_.skip_lines, family_, index, walker_.lines())) continue;
         if ((index & 1u) != 0) ReverseCurve(line_);
         stage_ = Stage::kLineStart;
         continue;

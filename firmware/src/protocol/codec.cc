@@ -73,6 +73,7 @@ void WriteCommandBody(const Command& command, Writer* w) {
       w->PutU16(p.lines_s);
       w->PutU16(p.lines_t);
       w->PutU32(p.tolerance_q8);
+      w->Put(p.skip_lines);
       for (int a = 0; a < GeometryAxes(p.dims); ++a) {
         for (const auto& row : p.geometry[a].g) {
           for (const GeometryFixed value : row) {
@@ -266,6 +267,8 @@ void ReadPatch(Reader* r, PatchCommand* p) {
   r->Check(p->lines_s != 0 || p->lines_t != 0, kPatchFieldLinesS);
   p->tolerance_q8 = r->U32(kPatchFieldTolerance);
   r->Check(p->tolerance_q8 > 0, kPatchFieldTolerance);
+  p->skip_lines = r->U8(kPatchFieldSkipLines);
+  r->Check((p->skip_lines & ~kSkipLinesMask) == 0, kPatchFieldSkipLines);
   const int axes = r->ok() ? p->dims : 0;
   uint8_t field = kPatchFieldGeometry;
   for (int a = 0; a < kMaxAxes; ++a) {

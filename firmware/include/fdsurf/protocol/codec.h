@@ -50,7 +50,8 @@ constexpr uint8_t kPatchFieldDims = 1;
 constexpr uint8_t kPatchFieldLinesS = 2;
 constexpr uint8_t kPatchFieldLinesT = 3;
 constexpr uint8_t kPatchFieldTolerance = 4;
-constexpr uint8_t kPatchFieldGeometry = 5;
+constexpr uint8_t kPatchFieldSkipLines = 5;
+constexpr uint8_t kPatchFieldGeometry = 6;
 // kCurve: geometry[axis].g[i] is field kCurveFieldGeometry + 4·axis + i.
 constexpr uint8_t kCurveFieldBasis = 0;
 constexpr uint8_t kCurveFieldDims = 1;

@@ -90,9 +90,20 @@ struct PatchCommand {
   uint16_t lines_t;
   /// Euclidean tolerance in 2^-8 steps (as AdaptiveSettings::tolerance_q8).
   uint32_t tolerance_q8;
+  /// Edge lines not to draw, because another patch draws the same curve:
+  /// kSkipFirstSLine | kSkipLastSLine | kSkipFirstTLine | kSkipLastTLine.
+  uint8_t skip_lines;
   /// Geometry in steps, Q47.16; only [0, dims) used.
   PatchGeometry1 geometry[kMaxAxes];
 };
+
+/// PatchCommand::skip_lines: the s-line at s = 0, at s = 1, the t-line at
+/// t = 0, at t = 1. The other bits must be 0.
+constexpr uint8_t kSkipFirstSLine = 0x01;
+constexpr uint8_t kSkipLastSLine = 0x02;
+constexpr uint8_t kSkipFirstTLine = 0x04;
+constexpr uint8_t kSkipLastTLine = 0x08;
+constexpr uint8_t kSkipLinesMask = 0x0F;
 
 /// Draw one cubic curve with the current pen state, starting with a straight
 /// move from the current position to the curve's start if they differ.

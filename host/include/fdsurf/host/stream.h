@@ -49,11 +49,16 @@ struct StreamJob {
   /// Tolerance in steps, and as the devices's 2^-8-step units.
   double tolerance_steps = 0;
   std::uint32_t tolerance_q8 = 0;
+  /// Edge lines left out because a patch earlier in the order draws the
+  /// same curve (PatchCommand::skip_lines).
+  std::size_t shared_edges_skipped = 0;
 };
 
 /// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
 /// tolerance, dims; the quantum is replaced by machine.step). Orders the
-/// patches by nearest neighbour so that travel between them stays short.
+/// patches by nearest neighbour so that travel between them stays short, and
+/// leaves out edge lines that an earlier patch draws already (patches of a
+/// surface share their edges: the teapot's 32 patches share 52).
 /// Throws InputError (options, travel too small for the page) and
 /// EngineError (a patch out of range).
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
