@@ -269,6 +269,8 @@ TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   ExpectRefused("stream '" + kTeapot + "' --travel 100x100", "--travel X 100 mm is smaller than");
   ExpectRefused("stream '" + kTeapot + "' --tolerance 0.005", "--tolerance 0.005 mm is too small");
   ExpectRefused("stream '" + kTeapot + "' --tick-hz 30000", "--tick-hz: 30000 does not divide");
+  ExpectRefused("stream '" + kTeapot + "' --tick-hz 5000",
+                "--speed 100 mm/s is 8000 steps/s, more than the device's 5000 ticks/s");
   ExpectRefused("stream '" + kTeapot + "' --device gpio:gpiochip0:1,2,3", "--device: ");
   // No such hardware here: a clear message and exit code 3.
   const RunResult usb = Run("stream '" + kTeapot + "' --device usb:1209:0001");

@@ -173,11 +173,22 @@ std::size_t CommandBytes(const StreamJob& job) {
   return bytes;
 }
 
+// A device moves at most one step per axis per tick.
+void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const StreamOptions& o) {
+  if (job.config.max_rate > tick_hz) {
+    throw InputError("--speed " + std::to_string(static_cast<int>(o.speed)) + " " + o.units +
+                     "/s is " + std::to_string(job.config.max_rate) +
+                     " steps/s, more than the device's " + std::to_string(tick_hz) +
+                     " ticks/s (one step per tick at most): lower --speed or raise --tick-hz");
+  }
+}
+
 int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
                  const ToolpathOptions& drawing, const std::string& units) {
   sim::PlotterOptions plotter_options;
   plotter_options.axes = o.dims;
   if (o.tick_hz != 0) plotter_options.tick_hz = o.tick_hz;
+  CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
   plotter_options.bytes_per_second = o.link_bytes_per_second;
   plotter_options.to_device = sim::FaultRates::All(o.faults);
   plotter_options.to_host = sim::FaultRates::All(o.faults);
@@ -338,11 +349,12 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
     throw InputError("--device: " + std::to_string(config.axes) +
                      " axes of lines given for --dims " + std::to_string(o.dims));
   }
+  const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
+  CheckSpeedAgainstTicks(job, tick_hz, o);
   std::unique_ptr<hal::GpiodOutputs> outputs;
   if (hal::GpiodOutputs::Open(config, &outputs, &error) != hal::IoStatus::kOk) {
     throw DeviceError(error);
   }
-  const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
   HostLink link(LinkOptions());
   Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
