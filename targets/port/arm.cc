@@ -2,10 +2,10 @@
 // handler, ARM semihosting (bkpt 0xAB) for output and the exit status.
 #include <stddef.h>
 #include <stdint.h>
-#include <string.h>
 
 #include "../image/image.h"
 #include "../image/port.h"
+#include "semihosting.h"
 
 extern "C" {
 // Linker script symbols (targets/link/arm-common.ld).
@@ -14,25 +14,16 @@ extern uint32_t __data_start[];
 extern uint32_t __data_end[];
 extern uint32_t __bss_start[];
 extern uint32_t __bss_end[];
-extern uint32_t __stack_limit[];
-extern uint32_t __stack_top[];
 extern void (*__init_array_start[])();
 extern void (*__init_array_end[])();
 
 void fdsurf_reset_handler();
 void fdsurf_fault_handler();
-__attribute__((noinline, used)) void fdsurf_image_mark();
 }
 
-namespace {
-
-constexpr uint32_t kStackPaint = 0xA5A5A5A5u;
-
-// SYS_WRITE0, SYS_EXIT and the exit reasons of the semihosting specification.
-constexpr uint32_t kSysWrite0 = 0x04;
-constexpr uint32_t kSysExit = 0x18;
-constexpr uint32_t kApplicationExit = 0x20026;
-constexpr uint32_t kRunTimeErrorUnknown = 0x20023;
+namespace fdsurf {
+namespace image {
+namespace semihosting {
 
 uint32_t Semihost(uint32_t operation, const void* argument) {
   register uint32_t r0 __asm__("r0") = operation;
@@ -41,51 +32,9 @@ uint32_t Semihost(uint32_t operation, const void* argument) {
   return r0;
 }
 
-// Output is sent a line at a time: one semihosting trap per line.
-char g_line[128];
-size_t g_line_length = 0;
-
-void Flush() {
-  g_line[g_line_length] = '\0';
-  Semihost(kSysWrite0, g_line);
-  g_line_length = 0;
-}
-
-}  // namespace
-
-namespace fdsurf {
-namespace image {
-
-void PortPutChar(char c) {
-  g_line[g_line_length++] = c;
-  if (c == '\n' || g_line_length == sizeof g_line - 1) Flush();
-}
-
-void PortReadRom(void* to, const void* from, size_t n) { memcpy(to, from, n); }
-
-void PortMark() { fdsurf_image_mark(); }
-
-uint32_t PortStackUsed() {
-  const uint32_t* p = __stack_limit;
-  while (p < __stack_top && *p == kStackPaint) ++p;
-  return static_cast<uint32_t>(reinterpret_cast<uintptr_t>(__stack_top) -
-                               reinterpret_cast<uintptr_t>(p));
-}
-
-void PortExit(int status) {
-  if (g_line_length != 0) Flush();
-  Semihost(kSysExit, reinterpret_cast<const void*>(static_cast<uintptr_t>(
-                         status == 0 ? kApplicationExit : kRunTimeErrorUnknown)));
-  for (;;) {
-  }
-}
-
+}  // namespace semihosting
 }  // namespace image
 }  // namespace fdsurf
-
-// The instruction-counting plugin (targets/sim/qemu_insn_count.c) records its
-// counter each time this function's first instruction executes.
-void fdsurf_image_mark() { __asm__ volatile("" ::: "memory"); }
 
 void fdsurf_fault_handler() { fdsurf::image::PortExit(99); }
 
@@ -101,7 +50,7 @@ void fdsurf_reset_handler() {
   // Paint the stack below this frame, for PortStackUsed.
   uint32_t* sp;
   __asm__ volatile("mov %0, sp" : "=r"(sp));
-  for (uint32_t* p = __stack_limit; p < sp - 16; ++p) *p = kStackPaint;
+  for (uint32_t* p = __stack_limit; p < sp - 16; ++p) *p = fdsurf::image::semihosting::kStackPaint;
   for (void (**f)() = __init_array_start; f < __init_array_end; ++f) (*f)();
   fdsurf::image::PortExit(fdsurf::image::RunImage(false));
 }

@@ -6,18 +6,16 @@
 
 #include "../image/image.h"
 #include "../image/port.h"
+#include "semihosting.h"
 
 extern "C" {
 // Linker script symbols (targets/link/riscv-virt.ld).
 extern uint32_t __bss_start[];
 extern uint32_t __bss_end[];
-extern uint32_t __stack_limit[];
-extern uint32_t __stack_top[];
 extern void (*__init_array_start[])();
 extern void (*__init_array_end[])();
 
 void fdsurf_riscv_main();
-__attribute__((noinline, used)) void fdsurf_image_mark();
 void* memcpy(void* to, const void* from, size_t n);
 void* memmove(void* to, const void* from, size_t n);
 void* memset(void* to, int value, size_t n);
@@ -33,13 +31,9 @@ __asm__(
     "  call fdsurf_riscv_main\n"
     "1: j 1b\n");
 
-namespace {
-
-constexpr uint32_t kStackPaint = 0xA5A5A5A5u;
-constexpr uint32_t kSysWrite0 = 0x04;
-constexpr uint32_t kSysExit = 0x18;
-constexpr uint32_t kApplicationExit = 0x20026;
-constexpr uint32_t kRunTimeErrorUnknown = 0x20023;
+namespace fdsurf {
+namespace image {
+namespace semihosting {
 
 // The RISC-V semihosting trap: ebreak between two marker instructions, all
 // uncompressed and in one aligned group.
@@ -60,16 +54,9 @@ __attribute__((noinline)) uint32_t Semihost(uint32_t operation, const void* argu
   return a0;
 }
 
-char g_line[128];
-size_t g_line_length = 0;
-
-void Flush() {
-  g_line[g_line_length] = '\0';
-  Semihost(kSysWrite0, g_line);
-  g_line_length = 0;
-}
-
-}  // namespace
+}  // namespace semihosting
+}  // namespace image
+}  // namespace fdsurf
 
 void* memcpy(void* to, const void* from, size_t n) {
   auto* d = static_cast<unsigned char*>(to);
@@ -95,43 +82,11 @@ void* memset(void* to, int value, size_t n) {
   return to;
 }
 
-namespace fdsurf {
-namespace image {
-
-void PortPutChar(char c) {
-  g_line[g_line_length++] = c;
-  if (c == '\n' || g_line_length == sizeof g_line - 1) Flush();
-}
-
-void PortReadRom(void* to, const void* from, size_t n) { memcpy(to, from, n); }
-
-void PortMark() { fdsurf_image_mark(); }
-
-uint32_t PortStackUsed() {
-  const uint32_t* p = __stack_limit;
-  while (p < __stack_top && *p == kStackPaint) ++p;
-  return static_cast<uint32_t>(reinterpret_cast<uintptr_t>(__stack_top) -
-                               reinterpret_cast<uintptr_t>(p));
-}
-
-void PortExit(int status) {
-  if (g_line_length != 0) Flush();
-  Semihost(kSysExit, reinterpret_cast<const void*>(static_cast<uintptr_t>(
-                         status == 0 ? kApplicationExit : kRunTimeErrorUnknown)));
-  for (;;) {
-  }
-}
-
-}  // namespace image
-}  // namespace fdsurf
-
-void fdsurf_image_mark() { __asm__ volatile("" ::: "memory"); }
-
 void fdsurf_riscv_main() {
   for (uint32_t* p = __bss_start; p < __bss_end; ++p) *p = 0;
   uint32_t* sp;
   __asm__ volatile("mv %0, sp" : "=r"(sp));
-  for (uint32_t* p = __stack_limit; p < sp - 16; ++p) *p = kStackPaint;
+  for (uint32_t* p = __stack_limit; p < sp - 16; ++p) *p = fdsurf::image::semihosting::kStackPaint;
   for (void (**f)() = __init_array_start; f < __init_array_end; ++f) (*f)();
   fdsurf::image::PortExit(fdsurf::image::RunImage(false));
 }
