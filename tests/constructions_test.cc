@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -473,6 +474,208 @@ TEST(ClosedNet, RefusesTooSmallNetsAndOtherBases) {
             }),
             "n.json: construct[0]: the net is 2x4 but needs at least 3x4 points (closed rows, "
             "open columns)");
+}
+
+// ---- Rows 5, 6, 9: interpolation and families (seeds 001, 003) -------------
+
+// The Lagrange cardinal function k on `nodes`, from its product formula.
+double Cardinal(const std::vector<double>& nodes, std::size_t k, double x) {
+  double value = 1;
+  for (std::size_t m = 0; m < nodes.size(); ++m) {
+    if (m != k) value *= (x - nodes[m]) / (nodes[k] - nodes[m]);
+  }
+  return value;
+}
+
+Point3 PointAt(int k, int l) { return {k + 0.3 * l, 0.5 * k * k - l, std::sin(k + 2.0 * l)}; }
+
+TEST(LagrangeGrid, CardinalFunctionsAreDeltasAtTheNodesAndSumToOne) {
+  const std::vector<double> nodes = {-1, 0.25, 0.5, 2};
+  const std::vector<Poly> basis = LagrangeBasis(nodes);
+  ASSERT_EQ(basis.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    for (std::size_t l = 0; l < 4; ++l) {
+      const double x = (nodes[l] - nodes[0]) / (nodes[3] - nodes[0]);
+      EXPECT_NEAR(EvaluatePoly(basis[k], x), k == l ? 1.0 : 0.0, 1e-13);
+    }
+  }
+  for (double x : {0.0, 0.1, 0.37, 0.9, 1.0}) {
+    double sum = 0;
+    for (const Poly& b : basis) sum += EvaluatePoly(b, x);
+    EXPECT_NEAR(sum, 1.0, 1e-13);
+  }
+  EXPECT_THROW(LagrangeBasis({0, 1, 1}), ConstructionError);
+  EXPECT_THROW(LagrangeBasis({0}), ConstructionError);
+}
+
+TEST(LagrangeGrid, InterpolatesANonUniformGridExactlyAsOnePatch) {
+  const std::vector<double> u = {0, 0.3, 1.7, 2};
+  const std::vector<double> v = {1, 1.5, 4};
+  std::vector<std::vector<Point3>> points(4);
+  for (int k = 0; k < 4; ++k) {
+    for (int l = 0; l < 3; ++l) points[k].push_back(PointAt(k, l));
+  }
+  const PatchSet set = AsSet(LagrangeGrid(u, v, points));
+  ASSERT_EQ(set.patches.size(), 1u);
+  const Patch& patch = set.patches[0];
+  for (int k = 0; k < 4; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      EXPECT_LT(Distance(EvaluateReference(patch, u[k] / 2, (v[l] - 1) / 3), points[k][l]), 1e-12);
+    }
+  }
+  // Anywhere: r = Σ c_kl·r_kl with c_kl = L_k(u)·M_l(v), summing to 1.
+  for (double s : {0.1, 0.6}) {
+    for (double t : {0.2, 0.75}) {
+      Point3 expected{};
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) {
+        for (int l = 0; l < 3; ++l) {
+          const double c = Cardinal(u, k, 2 * s) * Cardinal(v, l, 1 + 3 * t);
+          sum += c;
+          for (int a = 0; a < 3; ++a) expected[a] += c * points[k][l][a];
+        }
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12);
+      EXPECT_LT(Distance(EvaluateReference(patch, s, t), expected), 1e-12);
+    }
+  }
+  EXPECT_LE(WorstFixedError(set, 33, 17, Quantum::Parse("0.001")), 0.51);
+}
+
+TEST(LagrangeGrid, HigherDegreesArePiecesWithinTheirBound) {
+  const std::vector<double> u = {0, 0.2, 0.5, 0.6, 0.8, 1};  // degree 5
+  const std::vector<double> v = {0, 0.5, 1};
+  std::vector<std::vector<Point3>> points(6);
+  for (int k = 0; k < 6; ++k) {
+    for (int l = 0; l < 3; ++l) points[k].push_back(PointAt(k, l));
+  }
+  const double tolerance = 1e-6;
+  PatchSet set;
+  const double bound = AppendPatches(LagrangeGrid(u, v, points), tolerance, "t", &set.patches);
+  EXPECT_GT(set.patches.size(), 1u);
+  EXPECT_GT(bound, 0);
+  EXPECT_LE(bound, tolerance);
+  // The pieces tile [0,1]² in order: K_s rows of K_t pieces.
+  const auto kt =
+      static_cast<int>(std::count_if(set.patches.begin(), set.patches.end(), [](const Patch& p) {
+        return p.origin.find("piece (0,") != std::string::npos;
+      }));
+  const int ks = static_cast<int>(set.patches.size()) / kt;
+  double worst = 0;
+  for (int a = 0; a < ks; ++a) {
+    for (int b = 0; b < kt; ++b) {
+      for (double x : {0.0, 0.3, 0.5, 0.8, 1.0}) {
+        for (double y : {0.0, 0.4, 1.0}) {
+          const double s = (a + x) / ks;
+          const double t = (b + y) / kt;
+          Point3 exact{};
+          for (int k = 0; k < 6; ++k) {
+            for (int l = 0; l < 3; ++l) {
+              const double c = Cardinal(u, k, s) * Cardinal(v, l, t);
+              for (int i = 0; i < 3; ++i) exact[i] += c * points[k][l][i];
+            }
+          }
+          const Point3 got = EvaluateReference(set.patches[a * kt + b], x, y);
+          for (int i = 0; i < 3; ++i) worst = std::max(worst, std::fabs(got[i] - exact[i]));
+        }
+      }
+    }
+  }
+  EXPECT_LE(worst, bound + 1e-12);
+  EXPECT_LE(WorstFixedError(set, 8, 8, Quantum::Parse("0.001")), 0.51);
+}
+
+// A family of cubic curves c_i(u), each a Bézier curve lifted by i.
+std::vector<Curve> Family(int count) {
+  std::vector<Curve> curves;
+  for (int i = 0; i < count; ++i) {
+    const double z = i * 1.5;
+    const double y = std::sin(i);
+    curves.push_back(BezierCurve(
+        {{{0, y, z}, {1, y + 1, z + 0.5 * i}, {2, y - 1, z}, {3, y, z + 0.1 * i * i}}}));
+  }
+  return curves;
+}
+
+std::vector<VecPoly> Polys(const std::vector<Curve>& curves) {
+  std::vector<VecPoly> p;
+  for (const Curve& c : curves) p.push_back(CurvePolynomial(c));
+  return p;
+}
+
+TEST(LagrangeFamily, EveryVLineIsTheLagrangeCurveThroughTheFamily) {
+  const std::vector<double> v = {0, 1, 3, 4};  // non-uniform
+  const std::vector<Curve> family = Family(4);
+  const PatchSet set = AsSet(BlendCurves(Polys(family), LagrangeBasis(v)));
+  ASSERT_EQ(set.patches.size(), 1u);
+  for (double u : {0.0, 0.3, 1.0}) {
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_LT(
+          Distance(EvaluateReference(set.patches[0], u, v[i] / 4), EvaluateCurve(family[i], u)),
+          1e-12);
+    }
+    for (double t : {0.1, 0.5, 0.9}) {
+      Point3 expected{};
+      for (int i = 0; i < 4; ++i) {
+        const double w = Cardinal(v, i, 4 * t);
+        const Point3 c = EvaluateCurve(family[i], u);
+        for (int a = 0; a < 3; ++a) expected[a] += w * c[a];
+      }
+      EXPECT_LT(Distance(EvaluateReference(set.patches[0], u, t), expected), 1e-12);
+    }
+  }
+  EXPECT_LE(WorstFixedError(set, 33, 17, Quantum::Parse("0.001")), 0.51);
+}
+
+TEST(BezierFamily, TheCurvesAreControlCurves) {
+  for (int count : {2, 3, 4}) {
+    const std::vector<Curve> family = Family(count);
+    const PatchSet set = AsSet(BlendCurves(Polys(family), BernsteinBasis(count - 1)));
+    ASSERT_EQ(set.patches.size(), 1u);
+    for (double u : {0.0, 0.4, 1.0}) {
+      EXPECT_LT(Distance(EvaluateReference(set.patches[0], u, 0), EvaluateCurve(family[0], u)),
+                1e-12);
+      EXPECT_LT(Distance(EvaluateReference(set.patches[0], u, 1), EvaluateCurve(family.back(), u)),
+                1e-12);
+      for (double t : {0.25, 0.6}) {
+        // de Casteljau in v over the curves' points at u.
+        std::vector<Point3> p;
+        for (const Curve& c : family) p.push_back(EvaluateCurve(c, u));
+        for (std::size_t level = p.size() - 1; level > 0; --level) {
+          for (std::size_t i = 0; i < level; ++i) {
+            for (int a = 0; a < 3; ++a) p[i][a] += t * (p[i + 1][a] - p[i][a]);
+          }
+        }
+        EXPECT_LT(Distance(EvaluateReference(set.patches[0], u, t), p[0]), 1e-12);
+      }
+    }
+  }
+}
+
+TEST(Families, RefuseTooFewCurvesAndMismatchedParameters) {
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "lagrange-curves", "curves": [
+                {"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]}]}]})",
+                        "f.json");
+            }),
+            "f.json: construct[0].curves: needs at least 2 curves, got 1");
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "lagrange-curves", "v": [0, 0], "curves": [
+                {"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]},
+                {"basis": "bezier", "points": [[0,1],[1,1],[2,1],[3,1]]}]}]})",
+                        "f.json");
+            }),
+            "f.json: construct[0]: nodes[1] = 0 is not greater than nodes[0] = 0 (parameters must "
+            "increase)");
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "bezier-curves", "curves": [
+                {"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]},
+                [{"basis": "bezier", "points": [[0,1],[1,1],[2,1],[3,1]]},
+                 {"basis": "bezier", "points": [[3,1],[4,1],[5,1],[6,1]]}]]}]})",
+                        "f.json");
+            }),
+            "f.json: construct[0].curves[1]: has 2 segments but curve 0 has 1 (the curves must "
+            "have matching parameters)");
 }
 
 }  // namespace

@@ -120,20 +120,61 @@ double Falling(std::size_t n, int k) {
   return f;
 }
 
+double Binomial(std::size_t n, std::size_t k) {
+  double b = 1;
+  for (std::size_t i = 1; i <= k; ++i)
+    b = b * static_cast<double>(n - k + i) / static_cast<double>(i);
+  return b;
+}
+
 // max over [0,1]² and the coordinates of |∂^a_s ∂^b_t surface|, bounded by
-// the sum of the derivative's coefficients' magnitudes.
+// the largest Bernstein coefficient of the derivative (the Bernstein basis
+// is non-negative and sums to 1, so the polynomial lies within its
+// coefficients' range).
 double DerivativeBound(const PolySurface& surface, int a, int b) {
+  const std::size_t rows = surface.c.size();
+  const std::size_t cols = surface.c[0].size();
+  if (rows <= static_cast<std::size_t>(a) || cols <= static_cast<std::size_t>(b)) return 0;
+  const std::size_t n = rows - a - 1;  // degrees of the derivative
+  const std::size_t m = cols - b - 1;
   double worst = 0;
   for (int c = 0; c < 3; ++c) {
-    double sum = 0;
-    for (std::size_t i = a; i < surface.c.size(); ++i) {
-      for (std::size_t j = b; j < surface.c[i].size(); ++j) {
-        sum += std::fabs(surface.c[i][j][c]) * Falling(i, a) * Falling(j, b);
+    for (std::size_t i = 0; i <= n; ++i) {
+      for (std::size_t j = 0; j <= m; ++j) {
+        double bernstein = 0;
+        for (std::size_t p = 0; p <= i; ++p) {
+          for (std::size_t q = 0; q <= j; ++q) {
+            const double d = surface.c[p + a][q + b][c] * Falling(p + a, a) * Falling(q + b, b);
+            bernstein += Binomial(i, p) / Binomial(n, p) * Binomial(j, q) / Binomial(m, q) * d;
+          }
+        }
+        worst = std::max(worst, std::fabs(bernstein));
       }
     }
-    worst = std::max(worst, sum);
   }
   return worst;
+}
+
+// The same surface in a piece's parameters: s = s0 + hs·x, t = t0 + ht·y.
+PolySurface Reparametrise(const PolySurface& surface, double s0, double hs, double t0, double ht) {
+  const std::size_t rows = surface.c.size();
+  const std::size_t cols = surface.c[0].size();
+  PolySurface local;
+  local.c.assign(rows, std::vector<Point3>(cols, Point3{}));
+  for (std::size_t p = 0; p < rows; ++p) {
+    for (std::size_t q = 0; q < cols; ++q) {
+      for (std::size_t i = 0; i <= p; ++i) {
+        const double ws = Binomial(p, i) * std::pow(s0, static_cast<double>(p - i)) *
+                          std::pow(hs, static_cast<double>(i));
+        for (std::size_t j = 0; j <= q; ++j) {
+          const double wt = Binomial(q, j) * std::pow(t0, static_cast<double>(q - j)) *
+                            std::pow(ht, static_cast<double>(j));
+          local.c[i][j] = Add(local.c[i][j], Scale(surface.c[p][q], ws * wt));
+        }
+      }
+    }
+  }
+  return local;
 }
 
 void CheckIncreasing(const std::vector<double>& nodes, const char* name) {
@@ -246,29 +287,40 @@ double AppendPatches(const PolySurface& surface, double tolerance, const std::st
   }
   if (!(tolerance > 0)) throw ConstructionError("the tolerance must be positive");
   // Piecewise bicubic Hermite interpolation. With P_s, P_t the cubic Hermite
-  // interpolation operators, f − P_s·P_t·f = (f − P_s f) + P_s(f − P_t f);
+  // interpolation operators on a piece, f − P_s·P_t·f = (f − P_s f) + P_s(f − P_t f);
   // |f − P_x f| ≤ h⁴/384·max|f⁗| and |P_s g| ≤ max|g| + h_s/4·max|g_s|
   // (H0 + H1 = 1, |H2| + |H3| = w(1−w) ≤ 1/4), and ∂_s commutes with P_t.
-  const double m40 = DerivativeBound(surface, 4, 0);
-  const double m04 = DerivativeBound(surface, 0, 4);
-  const double m14 = DerivativeBound(surface, 1, 4);
-  constexpr int kMaxPieces = 64;
-  const auto pieces = [&](double m) {
-    for (int k = 1; k <= kMaxPieces; ++k) {
-      const double h = 1.0 / k;
-      if (h * h * h * h / 384 * m <= tolerance / 2) return k;
+  // In each piece's own parameters (h = 1) the bound is
+  // M₄₀/384 + (M₀₄ + M₁₄/4)/384, with M bounded by the local coefficients.
+  constexpr int kMaxPieces = 256;
+  int ks = 1;
+  int kt = 1;
+  double bound = 0;
+  for (;;) {
+    double worst_s = 0;
+    double worst_t = 0;
+    for (int a = 0; a < ks; ++a) {
+      for (int b = 0; b < kt; ++b) {
+        const PolySurface local = Reparametrise(surface, static_cast<double>(a) / ks, 1.0 / ks,
+                                                static_cast<double>(b) / kt, 1.0 / kt);
+        worst_s = std::max(worst_s, DerivativeBound(local, 4, 0) / 384);
+        worst_t = std::max(worst_t,
+                           (DerivativeBound(local, 0, 4) + DerivativeBound(local, 1, 4) / 4) / 384);
+      }
     }
-    throw ConstructionError("the surface has degree > 3 and needs more than " +
-                            std::to_string(kMaxPieces) +
-                            " bicubic pieces per direction for tolerance " + Format(tolerance) +
-                            "; give a larger \"tolerance\"");
-  };
-  const int ks = pieces(m40);
-  const int kt = pieces(m04 + m14 / 4);
+    bound = worst_s + worst_t;
+    if (bound <= tolerance) break;
+    if (worst_s > tolerance / 2) ks *= 2;
+    if (worst_t > tolerance / 2) kt *= 2;
+    if (ks > kMaxPieces || kt > kMaxPieces) {
+      throw ConstructionError("the surface has degree > 3 and needs more than " +
+                              std::to_string(kMaxPieces) +
+                              " bicubic pieces per direction for tolerance " + Format(tolerance) +
+                              "; give a larger \"tolerance\"");
+    }
+  }
   const double hs = 1.0 / ks;
   const double ht = 1.0 / kt;
-  const double bound =
-      hs * hs * hs * hs / 384 * m40 + ht * ht * ht * ht / 384 * (m04 + hs / 4 * m14);
   for (int a = 0; a < ks; ++a) {
     for (int b = 0; b < kt; ++b) {
       Patch patch;

@@ -55,10 +55,11 @@ Patch ToBezier(const Patch& patch);
 /// Appends `surface` to `out` as patches. Degree ≤ 3 in both parameters: one
 /// exact Bézier patch, returns 0. Otherwise K_s × K_t bicubic Hermite pieces
 /// interpolating position, first derivatives and twist at the piece corners,
-/// with K chosen so that the proven bound (docs/constructions.md)
-///   h_s⁴/384·M₄₀ + h_t⁴/384·(M₀₄ + h_s/4·M₁₄)
-/// is ≤ `tolerance`; returns that bound (file units, per coordinate).
-/// Throws ConstructionError if 64×64 pieces do not reach the tolerance.
+/// with K_s, K_t doubled until the proven bound (docs/constructions.md)
+///   max over pieces of (M₄₀ + M₀₄ + M₁₄/4)/384
+/// (M: derivative bounds in each piece's own parameters) is ≤ `tolerance`;
+/// returns that bound (file units, per coordinate). Throws
+/// ConstructionError if 256 pieces per direction do not reach it.
 double AppendPatches(const PolySurface& surface, double tolerance, const std::string& origin,
                      std::vector<Patch>* out);
 
