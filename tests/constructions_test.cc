@@ -678,5 +678,181 @@ TEST(Families, RefuseTooFewCurvesAndMismatchedParameters) {
             "have matching parameters)");
 }
 
+// ---- Row 7: Hermite surface over a family (seed 003, eq. 2.18) -------------
+
+// c(u, v) = A(u) + v·B(u) + v²·C(u): a family on which the three-point
+// derivative is exact, r_v = B + 2v·C.
+Curve QuadraticFamilyCurve(double v) {
+  std::array<Point3, 4> p{};
+  for (int k = 0; k < 4; ++k) {
+    const double a = k;
+    p[k] = {a + 0.1 * v * v, v + 0.2 * k * v, 0.3 * k * k - 0.5 * v * v + k * v};
+  }
+  return BezierCurve(p);
+}
+Point3 QuadraticFamilyDerivative(double v, double u) {
+  const double h = 1e-6;  // exact up to rounding: the family is quadratic in v
+  const Point3 a = EvaluateCurve(QuadraticFamilyCurve(v + h), u);
+  const Point3 b = EvaluateCurve(QuadraticFamilyCurve(v - h), u);
+  return {(a[0] - b[0]) / (2 * h), (a[1] - b[1]) / (2 * h), (a[2] - b[2]) / (2 * h)};
+}
+
+TEST(HermiteFamily, InterpolatesTheCurvesWithThreePointDerivativesAndNaturalEnds) {
+  const std::vector<double> v = {0, 0.5, 2, 2.5, 4};
+  std::vector<Curve> family;
+  for (double x : v) family.push_back(QuadraticFamilyCurve(x));
+  const std::vector<VecPoly> curves = Polys(family);
+  const std::vector<VecPoly> d = EstimateFamilyDerivatives(curves, v, false);
+  const std::vector<PolySurface> pieces = HermiteFamily(curves, d, v, false);
+  ASSERT_EQ(pieces.size(), 4u);
+  for (double u : {0.0, 0.3, 0.7, 1.0}) {
+    for (std::size_t i = 1; i + 1 < v.size(); ++i) {
+      EXPECT_LT(Distance(EvaluatePoly(d[i], u), QuadraticFamilyDerivative(v[i], u)), 1e-6) << i;
+    }
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      const double delta = v[i + 1] - v[i];
+      const Patch patch = AsSet(pieces[i]).patches[0];
+      EXPECT_LT(Distance(EvaluateReference(patch, u, 0), EvaluateCurve(family[i], u)), 1e-12);
+      EXPECT_LT(Distance(EvaluateReference(patch, u, 1), EvaluateCurve(family[i + 1], u)), 1e-12);
+      // r_v = r_w / Δ at both ends is the estimated derivative: C¹ in v.
+      const Point3 start = PolySurfaceDerivative(pieces[i], 0, 1, u, 0);
+      const Point3 end = PolySurfaceDerivative(pieces[i], 0, 1, u, 1);
+      const Point3 d0 = EvaluatePoly(d[i], u);
+      const Point3 d1 = EvaluatePoly(d[i + 1], u);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(start[c] / delta, d0[c], 1e-9);
+        EXPECT_NEAR(end[c] / delta, d1[c], 1e-9);
+      }
+    }
+    // Natural ends: r_vv = 0 across the edge curves.
+    const Point3 first = PolySurfaceDerivative(pieces.front(), 0, 2, u, 0);
+    const Point3 last = PolySurfaceDerivative(pieces.back(), 0, 2, u, 1);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(first[c], 0, 1e-9);
+      EXPECT_NEAR(last[c], 0, 1e-9);
+    }
+  }
+}
+
+TEST(HermiteFamily, ClosesInVWhenAskedAndInUWhenEveryCurveIsClosed) {
+  const std::vector<double> v = {0, 1, 2.5, 3};  // 3 curves, closing at v = 3
+  std::vector<Curve> family;
+  for (int i = 0; i < 3; ++i) {
+    const double z = i == 1 ? 1.0 : 0.0;
+    // A closed cubic: its first and last control points coincide.
+    family.push_back(BezierCurve(
+        {{{3.0 + i, 0, z}, {4.0 + i, 3, z + 1}, {2.0 + i, 3, z - 1}, {3.0 + i, 0, z}}}));
+  }
+  const std::vector<VecPoly> curves = Polys(family);
+  const std::vector<VecPoly> d = EstimateFamilyDerivatives(curves, v, true);
+  const std::vector<PolySurface> pieces = HermiteFamily(curves, d, v, true);
+  ASSERT_EQ(pieces.size(), 3u);
+  for (double u : {0.0, 0.4, 1.0}) {
+    // The last piece returns to curve 0, with the same v-derivative.
+    EXPECT_LT(Distance(EvaluatePolySurface(pieces[2], u, 1), EvaluateCurve(family[0], u)), 1e-12);
+    const Point3 out = PolySurfaceDerivative(pieces[0], 0, 1, u, 0);
+    const Point3 back = PolySurfaceDerivative(pieces[2], 0, 1, u, 1);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[c] / (v[1] - v[0]), back[c] / (v[3] - v[2]), 1e-9);
+    // Curve 0's derivative uses curve 2 at v = 0 − (3 − 2.5) as its left neighbour.
+    const Point3 c2 = EvaluateCurve(family[2], u);
+    const Point3 c0 = EvaluateCurve(family[0], u);
+    const Point3 c1 = EvaluateCurve(family[1], u);
+    const double vp = -0.5;
+    const double vq = 1;
+    const Point3 expected{
+        c2[0] * (0 - vq) / ((vp - 0) * (vp - vq)) + c0[0] * (-vp - vq) / ((0 - vp) * (0 - vq)) +
+            c1[0] * (0 - vp) / ((vq - vp) * (vq - 0)),
+        c2[1] * (0 - vq) / ((vp - 0) * (vp - vq)) + c0[1] * (-vp - vq) / ((0 - vp) * (0 - vq)) +
+            c1[1] * (0 - vp) / ((vq - vp) * (vq - 0)),
+        c2[2] * (0 - vq) / ((vp - 0) * (vp - vq)) + c0[2] * (-vp - vq) / ((0 - vp) * (0 - vq)) +
+            c1[2] * (0 - vp) / ((vq - vp) * (vq - 0))};
+    EXPECT_LT(Distance(EvaluatePoly(d[0], u), expected), 1e-12);
+  }
+  // Every curve is closed, so is every v-line of the surface: r(0,v) = r(1,v).
+  for (const PolySurface& piece : pieces) {
+    for (double t : {0.0, 0.3, 0.8}) {
+      EXPECT_LT(Distance(EvaluatePolySurface(piece, 0, t), EvaluatePolySurface(piece, 1, t)),
+                1e-12);
+    }
+  }
+  EXPECT_THROW(EstimateFamilyDerivatives({curves[0], curves[1]}, {0, 1, 2}, true),
+               ConstructionError);
+  EXPECT_THROW(EstimateFamilyDerivatives(curves, {0, 1, 1, 3}, true), ConstructionError);
+}
+
+TEST(HermiteFamily, JsonNotesAndRefusals) {
+  const PatchSet set = ReadPatchFile(FDSURF_EXAMPLES_DIR "/hermite-family.json");
+  bool cyclic = false;
+  for (const std::string& note : set.notes) {
+    cyclic = cyclic ||
+             note.find("cyclic in u (every curve is closed), cyclic in v") != std::string::npos;
+  }
+  EXPECT_TRUE(cyclic);
+  EXPECT_LE(WorstFixedError(set, 16, 16, Quantum::Parse("0.001")), 0.51);
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "hermite-curves", "v": [0, 2, 1], "curves": [
+                {"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]},
+                {"basis": "bezier", "points": [[0,1],[1,1],[2,1],[3,1]]},
+                {"basis": "bezier", "points": [[0,2],[1,2],[2,2],[3,2]]}]}]})",
+                        "h.json");
+            }),
+            "h.json: construct[0]: v[2] = 1 is not greater than v[1] = 2 (parameters must "
+            "increase)");
+}
+
+// ---- Row 8: transition surface (seed 003, eq. 2.19) ------------------------
+
+TEST(Transition, MatchesBothEdgesInPositionAndTangentDirection) {
+  Patch a = FlatPatch(0, 1, 0.5, 0.2);
+  Patch b = FlatPatch(0, 1.2, -0.3, 0.1);
+  for (auto& row : b.g) {
+    for (Point3& p : row) {
+      p[1] += 5;  // b lies beyond a's edge t = 1 (y = 3)
+      p[2] += 1;
+    }
+  }
+  const Transition t = TransitionSurface(a, b);
+  const Patch patch = AsSet(t.surface).patches[0];
+  // The scale factors, computed again with a fine midpoint mean.
+  const int n = 4000;
+  double distance = 0;
+  double length_a = 0;
+  double length_b = 0;
+  for (int k = 0; k < n; ++k) {
+    const double u = (k + 0.5) / n;
+    distance += Distance(EvaluateReference(a, u, 1), EvaluateReference(b, u, 0));
+    length_a += Distance(EvaluateReference(a, u, 1), EvaluateReference(a, u, 1 - 1e-6)) / 1e-6;
+    length_b += Distance(EvaluateReference(b, u, 1e-6), EvaluateReference(b, u, 0)) / 1e-6;
+  }
+  EXPECT_NEAR(t.k_a, distance / length_a, 1e-4 * t.k_a);
+  EXPECT_NEAR(t.k_b, distance / length_b, 1e-4 * t.k_b);
+  for (double u : {0.0, 0.25, 0.5, 1.0}) {
+    EXPECT_LT(Distance(EvaluateReference(patch, u, 0), EvaluateReference(a, u, 1)), 1e-12);
+    EXPECT_LT(Distance(EvaluateReference(patch, u, 1), EvaluateReference(b, u, 0)), 1e-12);
+    // Tangent directions across the edges: r_w ∥ a_v, r_w ∥ b_v, same sense.
+    const Point3 rw0 = Derivative(patch, u, 0, 1);
+    const Point3 av = Derivative(a, u, 1, 1);
+    const Point3 rw1 = Derivative(patch, u, 1, 1);
+    const Point3 bv = Derivative(b, u, 0, 1);
+    const auto cosine = [](const Point3& x, const Point3& y) {
+      return (x[0] * y[0] + x[1] * y[1] + x[2] * y[2]) /
+             (std::hypot(x[0], x[1], x[2]) * std::hypot(y[0], y[1], y[2]));
+    };
+    EXPECT_NEAR(cosine(rw0, av), 1, 1e-9);
+    EXPECT_NEAR(cosine(rw1, bv), 1, 1e-9);
+    EXPECT_NEAR(std::hypot(rw0[0], rw0[1], rw0[2]), t.k_a * std::hypot(av[0], av[1], av[2]), 1e-5);
+  }
+  PatchSet set;
+  set.patches = {patch};
+  EXPECT_LE(WorstFixedError(set, 33, 17, Quantum::Parse("0.001")), 0.51);
+  // Edges that coincide give zero scale factors: refused unless given.
+  Patch touching = a;
+  for (auto& row : touching.g) {
+    for (Point3& p : row) p[1] += 3;  // its edge t = 0 is a's edge t = 1
+  }
+  EXPECT_THROW(TransitionSurface(a, touching), ConstructionError);
+  EXPECT_NO_THROW(TransitionSurface(a, touching, 1, 1));
+}
+
 }  // namespace
 }  // namespace fdsurf::host

@@ -639,13 +639,19 @@ Transition TransitionSurface(const Patch& a, const Patch& b, double k_a, double 
   double distance = 0;
   double length_a = 0;
   double length_b = 0;
+  double scale = 1;
   for (int k = 0; k <= kSamples; ++k) {
     const double u = static_cast<double>(k) / kSamples;
     const double w = k == 0 || k == kSamples ? 0.5 : 1.0;
-    distance += w * Norm(Sub(EvaluatePoly(b0, u), EvaluatePoly(a1, u)));
+    const Point3 pa = EvaluatePoly(a1, u);
+    const Point3 pb = EvaluatePoly(b0, u);
+    for (int c = 0; c < 3; ++c) scale = std::max({scale, std::fabs(pa[c]), std::fabs(pb[c])});
+    distance += w * Norm(Sub(pb, pa));
     length_a += w * Norm(EvaluatePoly(a1_t, u));
     length_b += w * Norm(EvaluatePoly(b0_t, u));
   }
+  // Edges that coincide up to rounding have no distance to scale by.
+  if (distance <= 1e-12 * scale * kSamples) distance = 0;
   Transition result;
   result.k_a = k_a > 0 ? k_a : (length_a > 0 ? distance / length_a : 0);
   result.k_b = k_b > 0 ? k_b : (length_b > 0 ? distance / length_b : 0);
