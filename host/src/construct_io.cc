@@ -36,9 +36,17 @@ void CheckFields(const json& object, const Place& place, std::initializer_list<c
     std::string list;
     for (const char* name : allowed) {
       known = known || key == name;
-      list += std::string(list.empty() ? "" : ", ") + "\"" + name + "\"";
+      list += list.empty() ? "\"" : ", \"";
+      list += name;
+      list += '"';
     }
-    if (!known) throw place.Error("unknown field \"" + key + "\" (expected " + list + ")");
+    if (!known) {
+      std::string message = "unknown field \"" + key;
+      message += "\" (expected ";
+      message += list;
+      message += ")";
+      throw place.Error(message);
+    }
   }
   for (const char* name : required) {
     if (!object.contains(name)) throw place.Error(std::string("missing \"") + name + "\"");
@@ -281,6 +289,7 @@ void AddBlendedFamily(const json& e, const Place& place, bool lagrange, PatchSet
     const double tolerance = Tolerance(e, place, kApproximationTolerance);
     for (std::size_t k = 0; k < family[0].size(); ++k) {
       std::vector<VecPoly> curves;
+      curves.reserve(family.size());
       for (const auto& c : family) curves.push_back(CurvePolynomial(c[k]));
       Append(BlendCurves(curves, blend), tolerance, SegmentOrigin(place, k, family[0].size()), set);
     }
@@ -307,6 +316,7 @@ void AddHermiteFamily(const json& e, const Place& place, PatchSet* set) {
   try {
     for (std::size_t k = 0; k < family[0].size(); ++k) {
       std::vector<VecPoly> curves;
+      curves.reserve(family.size());
       for (const auto& c : family) curves.push_back(CurvePolynomial(c[k]));
       std::vector<VecPoly> d;
       if (derivatives.empty()) {
