@@ -6,6 +6,7 @@
 
 #include "fdsurf/host/constructions.h"
 #include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/quadric_hermite.h"
 
 namespace fdsurf::host {
 namespace {
@@ -396,6 +397,44 @@ void AddClosedNet(const json& e, const Place& place, PatchSet* set) {
   }
 }
 
+void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
+  CheckFields(e, place, {"type", "vertices", "normals", "triangles", "free", "tolerance"},
+              {"vertices", "normals", "triangles"});
+  QuadricMesh mesh;
+  mesh.vertices = ParsePoints(e["vertices"], place.Child("vertices"), 3);
+  mesh.normals = ParsePoints(e["normals"], place.Child("normals"), 3);
+  const Place tp = place.Child("triangles");
+  const json& triangles = e["triangles"];
+  if (!triangles.is_array() || triangles.empty()) {
+    throw tp.Error("must be a non-empty array of vertex index triples");
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const json& tri = triangles[t];
+    if (!tri.is_array() || tri.size() != 3) throw tp.Index(t).Error("must be [i, j, k]");
+    std::array<int, 3> indices{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (!tri[k].is_number_integer()) throw tp.Index(t).Index(k).Error("must be a vertex index");
+      indices[k] = tri[k].get<int>();
+    }
+    mesh.triangles.push_back(indices);
+  }
+  if (e.contains("free")) {
+    const Place fp = place.Child("free");
+    if (!e["free"].is_array()) throw fp.Error("must be an array with one list per triangle");
+    for (std::size_t t = 0; t < e["free"].size(); ++t) {
+      mesh.free.push_back(ParseNumbers(e["free"][t], fp.Index(t)));
+    }
+  }
+  const double tolerance = Tolerance(e, place, 1e-3);
+  try {
+    QuadricResult result = BuildQuadricMesh(mesh, tolerance, SegmentOrigin(place, 0, 1));
+    for (Patch& p : result.patches) set->patches.push_back(std::move(p));
+    for (std::string& note : result.notes) set->notes.push_back(std::move(note));
+  } catch (const ConstructionError& error) {
+    throw place.Error(error.what());
+  }
+}
+
 std::string PolyText(const VecPoly& p, int c) {
   std::string text;
   static const char* const kPower[4] = {"", "·u", "·u²", "·u³"};
@@ -501,10 +540,13 @@ void AddConstructions(const json& construct, const std::string& file, PatchSet* 
       AddTransition(e, p, set);
     } else if (type == "closed-net") {
       AddClosedNet(e, p, set);
+    } else if (type == "quadric-hermite") {
+      AddQuadricHermite(e, p, set);
     } else {
       throw p.Child("type").Error(
           "unknown construction (expected ruled, bilinear, coons, lagrange-grid, "
-          "lagrange-curves, bezier-curves, hermite-curves, transition or closed-net)");
+          "lagrange-curves, bezier-curves, hermite-curves, transition, closed-net or "
+          "quadric-hermite)");
     }
   }
 }
