@@ -402,7 +402,7 @@ TEST(BezierJoins, TheTeapotIsG1EverywhereItsPatchesMeet) {
   }
   EXPECT_EQ(joins.size(), 52u);
   EXPECT_EQ(c1, 46);
-  EXPECT_EQ(g1, 6);  // rim to body (legs 1:3) and the spout's two rings (4:3)
+  EXPECT_EQ(g1, 6);  // rim to body (legs 1:4), the spout's rings (4:1)
 }
 
 // ---- Row 11: closed spline nets (seed 004) ----------------------------------
