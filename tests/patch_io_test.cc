@@ -140,8 +140,10 @@ TEST(Json, RefusesMalformedInputNamingTheField) {
             "f.json: missing \"surfaces\"");
   EXPECT_EQ(ErrorOf([&] { ParseJson(R"({"units": "furlong", "surfaces": []})", "f.json"); }),
             "f.json: .units: must be \"mm\" or \"in\"");
-  EXPECT_EQ(ErrorOf([&] { ParseJson(R"({"surface": []})", "f.json"); }),
-            "f.json: unknown field \"surface\" (expected \"units\" and \"surfaces\")");
+  EXPECT_EQ(
+      ErrorOf([&] { ParseJson(R"({"surface": []})", "f.json"); }),
+      "f.json: unknown field \"surface\" (expected \"units\", \"surfaces\", \"construct\" and "
+      "\"curves\")");
   EXPECT_EQ(
       ErrorOf([&] { ParseJson(R"({"surfaces": [{"basis": "bezier", "nett": []}]})", "f.json"); }),
       "f.json: surfaces[0]: unknown field \"nett\" (expected \"basis\" and \"net\")");

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "construct_io.h"
+
 namespace fdsurf::host {
 namespace {
 
@@ -278,8 +280,9 @@ PatchSet ParseJson(const std::string& text, const std::string& name) {
   const JsonPlace root{name, ""};
   if (!doc.is_object()) throw root.Error("the top level must be an object");
   for (const auto& [key, unused] : doc.items()) {
-    if (key != "units" && key != "surfaces") {
-      throw root.Error(R"(unknown field ")" + key + R"(" (expected "units" and "surfaces"))");
+    if (key != "units" && key != "surfaces" && key != "construct" && key != "curves") {
+      throw root.Error(R"(unknown field ")" + key +
+                       R"(" (expected "units", "surfaces", "construct" and "curves"))");
     }
   }
   PatchSet set;
@@ -290,15 +293,22 @@ PatchSet ParseJson(const std::string& text, const std::string& name) {
     }
     set.units = units.get<std::string>();
   }
-  if (!doc.contains("surfaces")) throw root.Error(R"(missing "surfaces")");
-  const nlohmann::json& surfaces = doc["surfaces"];
-  const JsonPlace surfaces_place{name, "surfaces"};
-  if (!surfaces.is_array() || surfaces.empty()) {
-    throw surfaces_place.Error("must be a non-empty array");
+  const bool constructs = doc.contains("construct") || doc.contains("curves");
+  if (!doc.contains("surfaces") && !constructs) throw root.Error(R"(missing "surfaces")");
+  if (doc.contains("surfaces")) {
+    const nlohmann::json& surfaces = doc["surfaces"];
+    const JsonPlace surfaces_place{name, "surfaces"};
+    if (!surfaces.is_array() || surfaces.empty()) {
+      throw surfaces_place.Error("must be a non-empty array");
+    }
+    for (std::size_t i = 0; i < surfaces.size(); ++i) {
+      AddSurface(surfaces[i], surfaces_place.Index(i), &set);
+    }
   }
-  for (std::size_t i = 0; i < surfaces.size(); ++i) {
-    AddSurface(surfaces[i], surfaces_place.Index(i), &set);
-  }
+  // Constructions and curves (docs/constructions.md), after the surfaces so
+  // that a construction can refer to their patches by number.
+  if (doc.contains("construct")) AddConstructions(doc["construct"], name, &set);
+  if (doc.contains("curves")) AddCurves(doc["curves"], name, &set);
   return set;
 }
 

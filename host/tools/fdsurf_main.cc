@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli_options.h"
+#include "construct_commands.h"
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quantum.h"
@@ -99,8 +100,9 @@ int RunSample(const SampleOptions& options) {
       prepared.push_back(PrepareFixedPatch(patch, quantum, grid.steps_s, grid.steps_t));
     }
   }
+  const CurveSamples curves(set, quantum, grid.steps_s, fixed);
   Output out;
-  out.Append("patch,i,j,x,y,z\n");
+  if (!set.patches.empty()) out.Append("patch,i,j,x,y,z\n");
   for (std::size_t p = 0; p < set.patches.size(); ++p) {
     const std::string prefix = std::to_string(p) + ",";
     if (fixed) {
@@ -122,6 +124,7 @@ int RunSample(const SampleOptions& options) {
       }
     }
   }
+  curves.Write([&](const std::string& text) { out.Append(text); });
   return 0;
 }
 
@@ -139,8 +142,10 @@ int RunCheck(const SampleOptions& options) {
   std::size_t worst_patch = 0;
   std::printf("grid %dx%d, quantum %s %s, bound 0.51 quanta\n", grid.steps_s, grid.steps_t,
               quantum.Format(1).c_str(), units.c_str());
-  std::printf("patch  acc  frac  exact  max error (quanta)  max error (%s)  at (i,j)\n",
-              units.c_str());
+  if (!set.patches.empty()) {
+    std::printf("patch  acc  frac  exact  max error (quanta)  max error (%s)  at (i,j)\n",
+                units.c_str());
+  }
   for (std::size_t p = 0; p < set.patches.size(); ++p) {
     double patch_worst = 0;
     std::uint32_t at_i = 0;
@@ -165,10 +170,11 @@ int RunCheck(const SampleOptions& options) {
       worst_patch = p;
     }
   }
+  const double curve_worst = CheckCurves(set, quantum, grid.steps_s);
   std::printf("overall: max error %.6f quanta (%.3g %s) in patch %zu, %zu patches: %s\n", worst,
               worst * q, units.c_str(), worst_patch, set.patches.size(),
               worst <= 0.51 ? "within the 0.51-quantum bound" : "BOUND VIOLATED");
-  return worst <= 0.51 ? 0 : 1;
+  return worst <= 0.51 && curve_worst <= 0.51 ? 0 : 1;
 }
 
 std::string Number(double v) {
@@ -434,13 +440,19 @@ int Main(int argc, char** argv) {
       "forward differences and draws them; report what it drew.");
   AddStreamOptions(stream, &stream_options);
 
+  JoinsOptions joins_options;
+  CLI::App* joins = app.add_subcommand(
+      "joins", "Report for every shared edge of the patches whether the join is C0, G1 or C1.");
+  AddJoinsOptions(joins, &joins_options);
+
   // CLI11 would only say "a subcommand is required" for a mistyped command.
   const std::string first = argc > 1 ? argv[1] : "";
   if (argc > 1 && argv[1][0] != '-' && first != "sample" && first != "check" && first != "plot" &&
-      first != "render" && first != "stream") {
+      first != "render" && first != "stream" && first != "joins") {
     std::fprintf(
         stderr,
-        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render or stream)\n",
+        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream or "
+        "joins)\n",
         argv[1]);
     return 2;
   }
@@ -455,6 +467,7 @@ int Main(int argc, char** argv) {
     if (plot->parsed()) return RunPlot(plot_options, false);
     if (render->parsed()) return RunPlot(render_options, true);
     if (stream->parsed()) return RunStream(stream_options);
+    if (joins->parsed()) return RunJoins(joins_options);
   } catch (const InputError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
     return 2;

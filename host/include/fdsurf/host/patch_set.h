@@ -22,10 +22,23 @@ struct Patch {
   std::string origin;
 };
 
+/// One cubic curve segment x(u) = U·M·g, U = [u³ u² u 1], u in [0, 1]. For
+/// kHermite g = (P0, P1, T0, T1); for kPower g[i] multiplies u^(3-i).
+struct Curve {
+  Basis basis = Basis::kHermite;
+  std::array<Point3, 4> g{};
+  std::string origin;
+};
+
 struct PatchSet {
   /// "mm" or "in"; empty when the file does not say (BPT).
   std::string units;
   std::vector<Patch> patches;
+  /// Curves to evaluate on their own (JSON "curves", docs/constructions.md).
+  std::vector<Curve> curves;
+  /// What the constructions found, one line each (join classes, scale
+  /// factors, approximation bounds); `fdsurf check` prints them.
+  std::vector<std::string> notes;
 };
 
 }  // namespace fdsurf::host
