@@ -228,6 +228,34 @@ TEST(SimulatedPlotter, ResumesAfterAnUnplugAndDrawsTheSame) {
   }
 }
 
+TEST(SimulatedPlotter, StreamsTheCurvesOfAFileAsChains) {
+  // Two Hermite chains (examples/hermite-chain.json): CURVE commands, with a
+  // pen lift only between the chains.
+  const host::PatchSet set =
+      host::ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/hermite-chain.json");
+  host::ToolpathOptions options;
+  options.view = host::ParseView("top");
+  options.fit = std::array<double, 2>{60, 40};
+  options.margin = 2;
+  options.tolerance = 0.02;
+  options.mode = host::StepMode::kStepExact;
+  host::MachineOptions machine;
+  machine.pen_delay_ms = 5;
+  const host::StreamJob job = host::BuildStreamJob(set, options, machine, "mm");
+  ASSERT_EQ(job.curves.size(), 5u);
+  const Streamed run = Stream(job, PlotterOptions{});
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  EXPECT_EQ(run.drawn.size(), 2u);  // the chains are joined end to end
+  std::vector<ReferenceLine> reference;
+  for (auto& points : host::ReferenceLines(set, job)) reference.push_back({std::move(points)});
+  const DrawingComparison comparison = CompareDrawing(run.drawn, reference, 2);
+  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
+  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+}
+
 TEST(SimulatedPlotter, CurvesMovesAndPenCommandsThroughTheLink) {
   // A job by hand: travel, pen down, a Bézier curve, a straight move, pen up.
   host::StreamJob job = SmallTeapotJob();

@@ -124,6 +124,37 @@ TEST(Toolpath, EveryPointAndChordOfTheTeapotIsWithinTolerance) {
   }
 }
 
+TEST(Toolpath, CurvesOfTheFileAreDrawnWithinTolerance) {
+  // Hermite chains (docs/constructions.md, row 1) next to a patch, in every mode.
+  PatchSet set = ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/hermite-chain.json");
+  ASSERT_EQ(set.patches.size(), 0u);
+  ASSERT_EQ(set.curves.size(), 5u);
+  for (const StepMode mode : {StepMode::kAdaptive, StepMode::kFixed, StepMode::kStepExact}) {
+    ToolpathOptions o = Options("top", 0.02, 2, mode);
+    o.quantum = Quantum::Parse("0.005");
+    o.fit = std::array<double, 2>{120, 80};
+    const Toolpath path = BuildToolpath(set, o, "mm");
+    ASSERT_EQ(path.strokes.size(), 5u);
+    for (std::size_t k = 0; k < path.strokes.size(); ++k) {
+      EXPECT_EQ(path.strokes[k].curve, static_cast<std::ptrdiff_t>(k));
+    }
+    const Deviation d = Measure(set, path);
+    EXPECT_LE(d.points, 0.02);
+    EXPECT_LE(d.chords, 0.02);
+    // Inside the page.
+    for (const Stroke& s : path.strokes) {
+      for (const auto& p : s.points) {
+        EXPECT_GE(p[0] * 0.005, -1e-9);
+        EXPECT_LE(p[0] * 0.005, 120 + 1e-9);
+      }
+    }
+  }
+  set.patches = Teapot().patches;  // curves and patches together
+  const Toolpath both = BuildToolpath(set, Options("iso", 0.05, 2, StepMode::kAdaptive), "mm");
+  const Deviation d = Measure(set, both);
+  EXPECT_LE(d.chords, 0.05);
+}
+
 TEST(Toolpath, RandomPatchesOfEveryBasisStayWithinTolerance) {
   std::mt19937_64 rng(11);
   for (int trial = 0; trial < 8; ++trial) {

@@ -5,6 +5,8 @@
 #include <functional>
 #include <map>
 
+#include "fdsurf/adaptive.h"
+#include "fdsurf/host/constructions.h"
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/reference.h"
@@ -21,13 +23,24 @@ std::string Number(double v) {
 
 using Vec = std::array<double, 3>;
 
-// A point of the patch in steps, through the job's map.
-Vec InSteps(const Patch& patch, const StreamJob& job, double s, double t) {
-  Vec out = job.page.map.Apply(EvaluateReference(patch, s, t));
+// A point of the file in steps, through the job's map.
+Vec ToSteps(const Point3& model, const StreamJob& job) {
+  Vec out = job.page.map.Apply(model);
   const double step = job.page.quantum.value();
   for (double& c : out) c /= step;
   if (job.page.dims == 2) out[2] = 0;
   return out;
+}
+
+Vec InSteps(const Patch& patch, const StreamJob& job, double s, double t) {
+  return ToSteps(EvaluateReference(patch, s, t), job);
+}
+
+// Where the device's stepper puts a coordinate of value v (2^-16 steps):
+// rounded half up, as RoundToQuanta does.
+std::int32_t RoundedStep(std::int64_t v) {
+  return static_cast<std::int32_t>((v + (std::int64_t{1} << (kCoefficientFracBits - 1))) >>
+                                   kCoefficientFracBits);
 }
 
 double Distance(const Vec& a, const Vec& b) {
@@ -81,6 +94,68 @@ std::int32_t ToSteps(double length, const Quantum& step, const std::string& what
                      std::to_string(protocol::kMaxTravelSteps) + " steps of " + step.Format(1));
   }
   return static_cast<std::int32_t>(steps);
+}
+
+// The file's curves, in file order: CURVE commands with the pen down, and a
+// pen-up move only where a curve does not start where the one before ended
+// (so a chain is drawn in one stroke).
+void AddCurves(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
+               StreamJob* job) {
+  bool pen_down = false;
+  bool placed = false;
+  std::array<std::int32_t, 3> at{};
+  const auto pen = [&](bool down) {
+    protocol::Command command;
+    command.type = protocol::MessageType::kPen;
+    command.seq = 0;
+    command.body.pen.down = down;
+    job->commands.push_back(command);
+    job->labels.emplace_back(down ? "pen down" : "pen up");
+    pen_down = down;
+  };
+  for (std::size_t c = 0; c < set.curves.size(); ++c) {
+    const Curve& curve = set.curves[c];
+    protocol::Command command;
+    command.type = protocol::MessageType::kCurve;
+    command.seq = 0;
+    protocol::CurveCommand& body = command.body.curve;
+    body.basis = curve.basis;
+    body.dims = static_cast<std::uint8_t>(t.dims);
+    body.tolerance_q8 = job->tolerance_q8;
+    for (auto& axis : body.geometry) axis = CurveGeometry1{};
+    CurveToQuanta(curve, job->page.map, machine.step, t.dims, body.geometry);
+    // The device's first and last points of this curve, computed as it will.
+    PowerCurve1 power[protocol::kMaxAxes];
+    const Status status = CurvePowerCoefficients(body.geometry, curve.basis, power);
+    if (status != Status::kOk) {
+      throw EngineError(curve.origin + ": " + StatusMessage(status) + "; use a coarser --step");
+    }
+    std::array<std::int32_t, 3> start{};
+    std::array<std::int32_t, 3> end{};
+    for (int a = 0; a < protocol::kMaxAxes; ++a) {
+      const auto& k = power[a].c;
+      start[static_cast<std::size_t>(a)] = RoundedStep(k[3]);
+      end[static_cast<std::size_t>(a)] = RoundedStep(k[0] + k[1] + k[2] + k[3]);
+    }
+    if (!placed || start != at) {
+      if (pen_down) pen(false);
+      protocol::Command move;
+      move.type = protocol::MessageType::kMove;
+      move.seq = 0;
+      for (int a = 0; a < protocol::kMaxAxes; ++a) {
+        move.body.move.target[a] = start[static_cast<std::size_t>(a)];
+      }
+      job->commands.push_back(move);
+      job->labels.push_back("travel to curve " + std::to_string(c) + " (" + curve.origin + ")");
+    }
+    if (!pen_down) pen(true);
+    job->commands.push_back(command);
+    job->labels.push_back("curve " + std::to_string(c) + " (" + curve.origin + ")");
+    job->curves.push_back(c);
+    at = end;
+    placed = true;
+  }
+  if (pen_down) pen(false);
 }
 
 }  // namespace
@@ -216,6 +291,7 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     job.labels.push_back("patch " + std::to_string(best) + " (" + patch.origin + ")");
     job.patches.push_back(StreamedPatch{best, t.lines_s, t.lines_t});
   }
+  AddCurves(set, t, machine, &job);
   return job;
 }
 
@@ -261,6 +337,15 @@ std::vector<std::vector<std::array<double, 3>>> ReferenceLines(const PatchSet& s
     };
     add_family(streamed.lines_s, true);
     add_family(streamed.lines_t, false);
+  }
+  for (const std::size_t c : job.curves) {
+    std::vector<Vec> points;
+    constexpr int kSamples = 20000;
+    for (int k = 0; k <= kSamples; ++k) {
+      points.push_back(
+          ToSteps(EvaluateCurve(set.curves[c], static_cast<double>(k) / kSamples), job));
+    }
+    lines.push_back(std::move(points));
   }
   return lines;
 }

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "fdsurf/forward_difference.h"
+#include "fdsurf/host/constructions.h"
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/reference.h"
@@ -106,6 +107,17 @@ Box DrawingBox(const PatchSet& set, const ToolpathOptions& options) {
     family_box(IsolineFamily::kSLines, options.lines_s);
     family_box(IsolineFamily::kTLines, options.lines_t);
   }
+  for (const Curve& curve : set.curves) {
+    const VecPoly p = CurvePolynomial(curve);  // ascending powers
+    const std::array<double, 3>* axes[3] = {&options.view.right, &options.view.up,
+                                            &options.view.depth};
+    for (int a = 0; a < 3; ++a) {
+      const auto range = CubicRange(Dot(*axes[a], p[3]), Dot(*axes[a], p[2]), Dot(*axes[a], p[1]),
+                                    Dot(*axes[a], p[0]));
+      box.lo[a] = std::min(box.lo[a], range[0]);
+      box.hi[a] = std::max(box.hi[a], range[1]);
+    }
+  }
   return box;
 }
 
@@ -122,6 +134,19 @@ bool IsPoint(Basis basis, int i, int j) {
   }
 }
 
+// The same for a curve's geometry: Hermite tangents and the power
+// coefficients but the constant are vectors.
+bool IsCurvePoint(Basis basis, int k) {
+  switch (basis) {
+    case Basis::kHermite:
+      return k < 2;
+    case Basis::kPower:
+      return k == 3;
+    default:
+      return true;
+  }
+}
+
 std::string Number(double v) {
   std::ostringstream out;
   out.precision(6);
@@ -131,106 +156,129 @@ std::string Number(double v) {
 
 constexpr double kInverseSqrt[4] = {0, 1.0, 0.70710678118654752, 0.57735026918962576};
 
+// Why the engine refused a line, for the person who asked for it.
+[[noreturn]] void Refuse(const ToolpathOptions& options, Status status, const std::string& where) {
+  std::string why = where + ": ";
+  switch (status) {
+    case Status::kPrecisionUnreachable:
+      why += options.mode == StepMode::kStepExact
+                 ? "a step-exact path would need steps below 2^-30 of the curve or more than 128 "
+                   "accumulator bits; use a coarser quantum"
+                 : "the tolerance needs steps below 2^-30 of the curve; use a larger --tolerance";
+      break;
+    case Status::kGeometryOutOfRange:
+      why += "the curve could reach ±2^31 quanta; use a coarser quantum";
+      break;
+    default:
+      why += StatusMessage(status);
+  }
+  throw EngineError(why);
+}
+
+// Steps one cubic (power coefficients in 2^-16 quanta) into `stroke`, as the
+// options say: adaptive or step-exact forward differences, or the fewest
+// uniform steps that keep the tolerance. `where` names the line in errors.
 template <int kDims>
-void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
-               const ToolpathOptions& options, std::vector<Stroke>* strokes) {
-  const Quantum& quantum = options.quantum;
-  PatchGeometry1 geometry[kDims];
-  PatchToQuanta(patch, map, quantum, kDims, geometry);
-  const double tolerance_q = options.tolerance / quantum.value();
+void StepLine(const PowerCurve1 (&curve)[kDims], const ToolpathOptions& options,
+              const std::string& where, Stroke* stroke) {
+  const double tolerance_q = options.tolerance / options.quantum.value();
+  const auto add = [&](double param, const std::int32_t(&p)[kDims]) {
+    std::array<std::int64_t, 3> point{0, 0, 0};
+    for (int c = 0; c < kDims; ++c) point[c] = p[c];
+    // A repeated point draws nothing; the chord to the next point covers
+    // both parameter intervals (each is within the tolerance of it).
+    if (!stroke->points.empty() && stroke->points.back() == point) return;
+    stroke->points.push_back(point);
+    stroke->params.push_back(param);
+  };
+  if (options.mode == StepMode::kFixed) {
+    // The fewest uniform steps N with √d/8·max|x''|/N² + √d·0.511 ≤ tolerance (0.51 stepping,
+    // 2^-12 geometry and coefficient rounding).
+    double second = 0;
+    for (int c = 0; c < kDims; ++c) {
+      second = std::max(second, (6 * std::fabs(static_cast<double>(curve[c].c[0])) +
+                                 2 * std::fabs(static_cast<double>(curve[c].c[1]))) /
+                                    65536.0);
+    }
+    const double budget = tolerance_q * kInverseSqrt[kDims] - 0.511;
+    const double n = std::max(1.0, std::ceil(std::sqrt(second / (8 * budget)) * (1 + 1e-12)));
+    if (!(n <= kMaxCurveSteps)) Refuse(options, Status::kPrecisionUnreachable, where);
+    CurveGeometry1 power[kDims];
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) power[c].g[k] = GeometryFixed::FromRaw(curve[c].c[k]);
+    }
+    PreparedCurve<kDims> prepared;
+    const Status status = PrepareCurve(power, Basis::kPower, static_cast<std::uint16_t>(n),
+                                       PrepareOptions{}, &prepared);
+    if (status != Status::kOk) Refuse(options, status, where);
+    const auto sink = [&](std::uint32_t k, const std::int32_t(&p)[kDims]) { add(k / n, p); };
+    if (prepared.format.acc_bits == 64) {
+      CurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
+    } else {
+      CurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
+    }
+    return;
+  }
   AdaptiveSettings settings;
   settings.mode =
       options.mode == StepMode::kStepExact ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
   settings.tolerance_q8 =
       static_cast<std::uint32_t>(std::min(std::floor(tolerance_q * 256), 4294967295.0));
-
-  const auto refuse = [&](Status status, const std::string& line) {
-    std::string why = patch.origin + ": " + line + ": ";
-    switch (status) {
-      case Status::kPrecisionUnreachable:
-        why += options.mode == StepMode::kStepExact
-                   ? "a step-exact path would need steps below 2^-30 of the curve or more than 128 "
-                     "accumulator bits; use a coarser quantum"
-                   : "the tolerance needs steps below 2^-30 of the curve; use a larger --tolerance";
-        break;
-      case Status::kGeometryOutOfRange:
-        why += "the curve could reach ±2^31 quanta; use a coarser quantum";
-        break;
-      default:
-        why += StatusMessage(status);
-    }
-    throw EngineError(why);
+  PreparedAdaptiveCurve<kDims> prepared;
+  const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
+  if (status != Status::kOk) Refuse(options, status, where);
+  const double unit = std::ldexp(1.0, -prepared.finest_level);
+  const auto sink = [&](std::uint32_t position, const std::int32_t(&p)[kDims]) {
+    add(position * unit, p);
   };
+  if (prepared.format.acc_bits == 64) {
+    AdaptiveCurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
+  } else {
+    AdaptiveCurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
+  }
+}
 
+template <int kDims>
+void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
+               const ToolpathOptions& options, std::vector<Stroke>* strokes) {
+  PatchGeometry1 geometry[kDims];
+  PatchToQuanta(patch, map, options.quantum, kDims, geometry);
   const auto draw_family = [&](IsolineFamily family, int lines) {
     if (lines == 0) return;
     IsolineWalker<kDims> walker;
     const Status created = IsolineWalker<kDims>::Create(geometry, patch.basis, family,
                                                         static_cast<std::uint16_t>(lines), &walker);
-    if (created != Status::kOk) refuse(created, "isolines");
+    if (created != Status::kOk) Refuse(options, created, patch.origin + ": isolines");
     PowerCurve1 curve[kDims];
     for (int i = 0; walker.Next(curve); ++i) {
       Stroke stroke;
       stroke.patch = index;
       stroke.family = family;
       stroke.line_param = LineParam(i, lines);
-      const std::string name =
-          std::string(family == IsolineFamily::kSLines ? "s" : "t") + "-line " + std::to_string(i);
-      const auto add = [&](double param, const std::int32_t(&p)[kDims]) {
-        std::array<std::int64_t, 3> point{0, 0, 0};
-        for (int c = 0; c < kDims; ++c) point[c] = p[c];
-        // A repeated point draws nothing; the chord to the next point covers
-        // both parameter intervals (each is within the tolerance of it).
-        if (!stroke.points.empty() && stroke.points.back() == point) return;
-        stroke.points.push_back(point);
-        stroke.params.push_back(param);
-      };
-      if (options.mode == StepMode::kFixed) {
-        // The fewest uniform steps N with √d/8·max|x''|/N² + √d·0.511 ≤ tolerance (0.51 stepping,
-        // 2^-12 geometry and coefficient rounding).
-        double second = 0;
-        for (int c = 0; c < kDims; ++c) {
-          second = std::max(second, (6 * std::fabs(static_cast<double>(curve[c].c[0])) +
-                                     2 * std::fabs(static_cast<double>(curve[c].c[1]))) /
-                                        65536.0);
-        }
-        const double budget = tolerance_q * kInverseSqrt[kDims] - 0.511;
-        const double n = std::max(1.0, std::ceil(std::sqrt(second / (8 * budget)) * (1 + 1e-12)));
-        if (!(n <= kMaxCurveSteps)) refuse(Status::kPrecisionUnreachable, name);
-        CurveGeometry1 power[kDims];
-        for (int c = 0; c < kDims; ++c) {
-          for (int k = 0; k < 4; ++k) power[c].g[k] = GeometryFixed::FromRaw(curve[c].c[k]);
-        }
-        PreparedCurve<kDims> prepared;
-        const Status status = PrepareCurve(power, Basis::kPower, static_cast<std::uint16_t>(n),
-                                           PrepareOptions{}, &prepared);
-        if (status != Status::kOk) refuse(status, name);
-        const auto sink = [&](std::uint32_t k, const std::int32_t(&p)[kDims]) { add(k / n, p); };
-        if (prepared.format.acc_bits == 64) {
-          CurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
-        } else {
-          CurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
-        }
-      } else {
-        PreparedAdaptiveCurve<kDims> prepared;
-        const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
-        if (status != Status::kOk) refuse(status, name);
-        const double unit = std::ldexp(1.0, -prepared.finest_level);
-        const auto sink = [&](std::uint32_t position, const std::int32_t(&p)[kDims]) {
-          add(position * unit, p);
-        };
-        if (prepared.format.acc_bits == 64) {
-          AdaptiveCurveStepper<std::int64_t, kDims>(prepared).ForEachPoint(sink);
-        } else {
-          AdaptiveCurveStepper<Int128, kDims>(prepared).ForEachPoint(sink);
-        }
-      }
+      StepLine(curve, options,
+               patch.origin + ": " + (family == IsolineFamily::kSLines ? "s" : "t") + "-line " +
+                   std::to_string(i),
+               &stroke);
       // A line that collapses to a point (a pole, like the teapot lid's top) draws nothing.
       if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
     }
   };
   draw_family(IsolineFamily::kSLines, options.lines_s);
   draw_family(IsolineFamily::kTLines, options.lines_t);
+}
+
+template <int kDims>
+void DrawCurve(const Curve& curve, std::size_t index, const OutputMap& map,
+               const ToolpathOptions& options, std::vector<Stroke>* strokes) {
+  CurveGeometry1 geometry[kDims];
+  CurveToQuanta(curve, map, options.quantum, kDims, geometry);
+  PowerCurve1 power[kDims];
+  const Status status = CurvePowerCoefficients(geometry, curve.basis, power);
+  if (status != Status::kOk) Refuse(options, status, curve.origin);
+  Stroke stroke;
+  stroke.curve = static_cast<std::ptrdiff_t>(index);
+  StepLine(power, options, curve.origin, &stroke);
+  if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
 }
 
 double PlaneDistance(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b) {
@@ -278,6 +326,25 @@ void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quan
         geometry[c].g[i][j] = GeometryFixed::FromRaw(
             static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
       }
+    }
+  }
+}
+
+void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
+                   CurveGeometry1* geometry) {
+  const double limit = std::ldexp(1.0, 31);
+  for (int k = 0; k < 4; ++k) {
+    const auto out =
+        IsCurvePoint(curve.basis, k) ? map.Apply(curve.g[k]) : map.ApplyLinear(curve.g[k]);
+    for (int c = 0; c < dims; ++c) {
+      const double q = quantum.ToQuanta(out[c]);
+      if (!(std::fabs(q) < limit)) {
+        throw EngineError(curve.origin + ": in output space a control value reaches " +
+                          Number(out[c]) + " units, beyond ±2^31 quanta of " + quantum.Format(1) +
+                          "; use a coarser quantum or a smaller --fit");
+      }
+      geometry[c].g[k] = GeometryFixed::FromRaw(
+          static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
     }
   }
 }
@@ -352,7 +419,9 @@ Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std
                      Number(needed * 1.003) + " " + units + " (√" + std::to_string(options.dims) +
                      "·0.501 quanta)");
   }
-  if (set.patches.empty()) throw InputError("the file has no patches to draw");
+  if (set.patches.empty() && set.curves.empty()) {
+    throw InputError("the file has no patches or curves to draw");
+  }
 
   Toolpath path;
   path.dims = options.dims;
@@ -403,15 +472,27 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
       progress(p + 1, set.patches.size(), points);
     }
   }
+  for (std::size_t c = 0; c < set.curves.size(); ++c) {
+    if (options.dims == 3) {
+      DrawCurve<3>(set.curves[c], c, path.map, options, &path.strokes);
+    } else {
+      DrawCurve<2>(set.curves[c], c, path.map, options, &path.strokes);
+    }
+  }
   return path;
 }
 
 std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
                                        const Stroke& stroke, double param) {
-  const Patch& patch = set.patches[stroke.patch];
-  const Point3 p = stroke.family == IsolineFamily::kSLines
-                       ? EvaluateReference(patch, stroke.line_param, param)
-                       : EvaluateReference(patch, param, stroke.line_param);
+  Point3 p{};
+  if (stroke.curve >= 0) {
+    p = EvaluateCurve(set.curves[static_cast<std::size_t>(stroke.curve)], param);
+  } else {
+    const Patch& patch = set.patches[stroke.patch];
+    p = stroke.family == IsolineFamily::kSLines
+            ? EvaluateReference(patch, stroke.line_param, param)
+            : EvaluateReference(patch, param, stroke.line_param);
+  }
   auto out = path.map.Apply(p);
   if (path.dims == 2) out[2] = 0;
   return out;

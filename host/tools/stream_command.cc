@@ -243,11 +243,16 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
     for (const sim::DrawnPath& p : drawn) points += p.points.size();
     const std::size_t command_bytes = CommandBytes(job);
     const std::size_t gcode_bytes = GcodeBytes(set, drawing, units);
-    std::fprintf(stderr,
-                 "%s: %zu patches streamed to the simulated plotter (%u axes, %u Hz ticks); %zu "
-                 "shared edges drawn once\n",
-                 o.file.c_str(), job.patches.size(), plotter_options.axes, plotter_options.tick_hz,
-                 job.shared_edges_skipped);
+    const std::string what =
+        std::to_string(job.patches.size()) + " patches" +
+        (job.curves.empty() ? std::string()
+                            : " and " + std::to_string(job.curves.size()) + " curves");
+    std::fprintf(
+        stderr,
+        "%s: %s streamed to the simulated plotter (%u axes, %u Hz ticks); %zu shared edges "
+        "drawn once\n",
+        o.file.c_str(), what.c_str(), plotter_options.axes, plotter_options.tick_hz,
+        job.shared_edges_skipped);
     std::fprintf(stderr,
                  "link: %llu frames sent (%llu commands, %llu resent), %llu bytes to the device, "
                  "%llu NAKs, %llu timeouts; all acknowledged after %.2f s\n",
@@ -258,7 +263,7 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                  static_cast<unsigned long long>(run.host.naks),
                  static_cast<unsigned long long>(run.host.timeouts), run.acknowledged_us * 1e-6);
     std::fprintf(stderr,
-                 "wire: %zu bytes of patch frames vs %zu bytes of G-code for the same drawing at "
+                 "wire: %zu bytes of command frames vs %zu bytes of G-code for the same drawing at "
                  "the same tolerance (%.1fx smaller)\n",
                  command_bytes, gcode_bytes,
                  static_cast<double>(gcode_bytes) / static_cast<double>(command_bytes));

@@ -40,10 +40,13 @@ struct StreamedPatch {
 
 struct StreamJob {
   protocol::MachineConfig config{};
-  /// CONFIG first, then one PATCH per patch, in drawing order.
+  /// CONFIG first, then one PATCH per patch, in drawing order, then the
+  /// file's curves (PEN, MOVE and CURVE commands).
   std::vector<protocol::Command> commands;
   std::vector<std::string> labels;
   std::vector<StreamedPatch> patches;
+  /// The file's curves (PatchSet::curves indices), drawn after the patches.
+  std::vector<std::size_t> curves;
   /// The page and the map from file units to output units; quantum = step.
   Toolpath page;
   /// Tolerance in steps, and as the devices's 2^-8-step units.

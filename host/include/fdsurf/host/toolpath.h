@@ -86,6 +86,9 @@ struct Stroke {
   std::vector<double> params;
   std::size_t patch = 0;
   IsolineFamily family = IsolineFamily::kSLines;
+  /// For a curve of the file (PatchSet::curves) rather than an isoline: its
+  /// index; -1 for isolines.
+  std::ptrdiff_t curve = -1;
   /// Fixed parameter of the isoline (s for s-lines, t for t-lines).
   double line_param = 0;
 };
@@ -119,7 +122,11 @@ Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std
 void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quantum, int dims,
                    PatchGeometry1* geometry);
 
-/// Draws every patch's isolines. Throws InputError for options that cannot
+/// The same for a curve (points by the whole map, vectors by its linear part).
+void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
+                   CurveGeometry1* geometry);
+
+/// Draws every patch's isolines, then the file's curves. Throws InputError for options that cannot
 /// be met (tolerance below the quantum's reach, a drawing that does not fit)
 /// and EngineError (fixed_engine.h) when the engine refuses a curve.
 Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
