@@ -109,9 +109,9 @@ class Device {
   /// or one pen change, written to the outputs. An output error faults the
   /// device (it stops; STATUS reports it).
   hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) {
-    // After a fault the motion still comes to rest along its path, unless
-    // the outputs themselves failed.
-    if (outputs_failed_ || (fault_ && !motion_.Stopping())) return hal::IoStatus::kOk;
+    // After a fault the motion still comes to rest along its path and the
+    // pen is lifted, unless the outputs themselves failed.
+    if (outputs_failed_ || (fault_ && motion_.Idle())) return hal::IoStatus::kOk;
     const motion::TickOutput out = motion_.Tick();
     executed_ += out.commands_done;
     hal::IoStatus status = hal::IoStatus::kOk;
