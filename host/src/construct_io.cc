@@ -13,15 +13,7 @@ namespace {
 
 using nlohmann::json;
 
-struct Place {
-  const std::string& file;
-  std::string path;
-  InputError Error(const std::string& what) const {
-    return InputError(file + ": " + (path.empty() ? "" : path + ": ") + what);
-  }
-  Place Child(const std::string& key) const { return {file, path + "." + key}; }
-  Place Index(std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
-};
+using Place = JsonPlace;
 
 std::string Format(double v) {
   char text[32];
@@ -100,16 +92,6 @@ std::vector<double> ParseNumbers(const json& value, const Place& place) {
   for (std::size_t k = 0; k < value.size(); ++k)
     numbers.push_back(Number(value[k], place.Index(k)));
   return numbers;
-}
-
-Basis ParseBasis(const json& value, const Place& place) {
-  if (!value.is_string()) throw place.Error("must be a string");
-  const std::string name = value.get<std::string>();
-  for (int b = 0; b < kBasisCount; ++b) {
-    if (name == BasisName(static_cast<Basis>(b))) return static_cast<Basis>(b);
-  }
-  throw place.Error("unknown basis '" + name +
-                    "' (expected bezier, hermite, bspline, catmull-rom or power)");
 }
 
 // {"basis": B, "points": [4 points]}: one cubic segment.

@@ -1,13 +1,28 @@
-// Reading the JSON "construct" and "curves" arrays (docs/formats.md,
+// JSON input shared by the readers, and the JSON "construct" and "curves" arrays (docs/formats.md,
 // docs/constructions.md). Private to the host library: patch_io.cc calls it.
 #pragma once
 
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
+
+/// Where a JSON value sits, for messages: "file: surfaces[0].net[1][2]: ...".
+struct JsonPlace {
+  const std::string& file;
+  std::string path;
+  InputError Error(const std::string& what) const {
+    return InputError(file + ": " + (path.empty() ? "" : path + ": ") + what);
+  }
+  JsonPlace Child(const std::string& key) const { return {file, path + "." + key}; }
+  JsonPlace Index(std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
+};
+
+/// A basis name ("bezier", "hermite", ...); InputError at `place` otherwise.
+Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place);
 
 /// Appends the patches of every construction in `construct` (a JSON array) to
 /// `set`; constructions may refer to patches already in the set by number.

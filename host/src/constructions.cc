@@ -6,43 +6,10 @@
 #include <numbers>
 
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/vec3.h"
 
 namespace fdsurf::host {
 namespace {
-
-using Matrix4 = std::array<std::array<double, 4>, 4>;
-
-// U·M for U = [u³ u² u 1]: row r of M multiplies u^(3-r) (seed 004; the
-// same matrices as reference.cc, written here for curves).
-Matrix4 CurveBasis(Basis basis) {
-  switch (basis) {
-    case Basis::kPower:
-      return {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
-    case Basis::kHermite:
-      return {{{2, -2, 1, 1}, {-3, 3, -2, -1}, {0, 0, 1, 0}, {1, 0, 0, 0}}};
-    case Basis::kBezier:
-      return {{{-1, 3, -3, 1}, {3, -6, 3, 0}, {-3, 3, 0, 0}, {1, 0, 0, 0}}};
-    case Basis::kBSpline: {
-      const double k = 1.0 / 6.0;
-      return {{{-k, 3 * k, -3 * k, k},
-               {3 * k, -6 * k, 3 * k, 0},
-               {-3 * k, 0, 3 * k, 0},
-               {k, 4 * k, k, 0}}};
-    }
-    case Basis::kCatmullRom:
-      return {{{-0.5, 1.5, -1.5, 0.5}, {1, -2.5, 2, -0.5}, {-0.5, 0, 0.5, 0}, {0, 1, 0, 0}}};
-  }
-  throw ConstructionError("unknown basis");
-}
-
-Point3 Add(const Point3& a, const Point3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Point3 Sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point3 Scale(const Point3& a, double k) { return {a[0] * k, a[1] * k, a[2] * k}; }
-double Dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double Norm(const Point3& a) { return std::sqrt(Dot(a, a)); }
-Point3 Cross(const Point3& a, const Point3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 
 std::string Format(const Point3& p) {
   char text[96];
@@ -196,7 +163,7 @@ void CheckIncreasing(const std::vector<double>& nodes, const char* name) {
 // ---- Polynomials ------------------------------------------------------------
 
 VecPoly CurvePolynomial(const Curve& curve) {
-  const Matrix4 m = CurveBasis(curve.basis);
+  const BasisMatrix4 m = ReferenceBasisMatrix(curve.basis);
   VecPoly p(4, Point3{});
   for (int r = 0; r < 4; ++r) {
     for (int i = 0; i < 4; ++i) p[3 - r] = Add(p[3 - r], Scale(curve.g[i], m[r][i]));
@@ -205,7 +172,7 @@ VecPoly CurvePolynomial(const Curve& curve) {
 }
 
 Point3 EvaluateCurve(const Curve& curve, double u) {
-  const Matrix4 m = CurveBasis(curve.basis);
+  const BasisMatrix4 m = ReferenceBasisMatrix(curve.basis);
   const double powers[4] = {u * u * u, u * u, u, 1.0};
   Point3 p{};
   for (int i = 0; i < 4; ++i) {

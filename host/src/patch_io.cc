@@ -80,26 +80,6 @@ class BptTokens {
 
 // ---- JSON -----------------------------------------------------------------
 
-struct JsonPlace {
-  const std::string& file;
-  std::string path;
-  InputError Error(const std::string& what) const {
-    return InputError(file + ": " + (path.empty() ? "" : path + ": ") + what);
-  }
-  JsonPlace Child(const std::string& key) const { return {file, path + "." + key}; }
-  JsonPlace Index(std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
-};
-
-Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
-  if (!value.is_string()) throw place.Error("must be a string");
-  const std::string name = value.get<std::string>();
-  for (int b = 0; b < kBasisCount; ++b) {
-    if (name == BasisName(static_cast<Basis>(b))) return static_cast<Basis>(b);
-  }
-  throw place.Error("unknown basis '" + name +
-                    "' (expected bezier, hermite, bspline, catmull-rom or power)");
-}
-
 using Net = std::vector<std::vector<Point3>>;
 
 Net ParseNet(const nlohmann::json& value, const JsonPlace& place) {
@@ -310,6 +290,16 @@ PatchSet ParseJson(const std::string& text, const std::string& name) {
   if (doc.contains("construct")) AddConstructions(doc["construct"], name, &set);
   if (doc.contains("curves")) AddCurves(doc["curves"], name, &set);
   return set;
+}
+
+Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
+  if (!value.is_string()) throw place.Error("must be a string");
+  const std::string name = value.get<std::string>();
+  for (int b = 0; b < kBasisCount; ++b) {
+    if (name == BasisName(static_cast<Basis>(b))) return static_cast<Basis>(b);
+  }
+  throw place.Error("unknown basis '" + name +
+                    "' (expected bezier, hermite, bspline, catmull-rom or power)");
 }
 
 PatchSet ReadPatchFile(const std::string& path) {

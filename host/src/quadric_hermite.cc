@@ -8,18 +8,11 @@
 #include <numbers>
 
 #include "fdsurf/host/constructions.h"
+#include "fdsurf/host/vec3.h"
 
 namespace fdsurf::host {
 namespace {
 
-Point3 Add(const Point3& a, const Point3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-Point3 Sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Point3 Scale(const Point3& a, double k) { return {a[0] * k, a[1] * k, a[2] * k}; }
-double Dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double Norm(const Point3& a) { return std::sqrt(Dot(a, a)); }
-Point3 Cross(const Point3& a, const Point3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 Point3 Unit(const Point3& a) { return Scale(a, 1 / Norm(a)); }
 
 std::string Format(double v) {

@@ -5,33 +5,8 @@
 namespace fdsurf::host {
 namespace {
 
-using Matrix4 = std::array<std::array<double, 4>, 4>;
-
-// The basis matrices again, in floating point, so that the reference does not
-// depend on the engine's integer tables (seed 004; Catmull & Rom 1974).
-Matrix4 ReferenceBasis(Basis basis) {
-  switch (basis) {
-    case Basis::kPower:
-      return {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
-    case Basis::kHermite:
-      return {{{2, -2, 1, 1}, {-3, 3, -2, -1}, {0, 0, 1, 0}, {1, 0, 0, 0}}};
-    case Basis::kBezier:
-      return {{{-1, 3, -3, 1}, {3, -6, 3, 0}, {-3, 3, 0, 0}, {1, 0, 0, 0}}};
-    case Basis::kBSpline: {
-      const double k = 1.0 / 6.0;
-      return {{{-k, 3 * k, -3 * k, k},
-               {3 * k, -6 * k, 3 * k, 0},
-               {-3 * k, 0, 3 * k, 0},
-               {k, 4 * k, k, 0}}};
-    }
-    case Basis::kCatmullRom:
-      return {{{-0.5, 1.5, -1.5, 0.5}, {1, -2.5, 2, -0.5}, {-0.5, 0, 0.5, 0}, {0, 1, 0, 0}}};
-  }
-  throw std::invalid_argument("unknown basis");
-}
-
 // Blending weights S·M for the parameter u: w[i] multiplies geometry row i.
-std::array<double, 4> Weights(const Matrix4& m, double u) {
+std::array<double, 4> Weights(const BasisMatrix4& m, double u) {
   const double powers[4] = {u * u * u, u * u, u, 1.0};
   std::array<double, 4> w{};
   for (int i = 0; i < 4; ++i) {
@@ -59,9 +34,32 @@ Point3 EvaluateDeCasteljau(const Patch& patch, double s, double t) {
   return DeCasteljauCurve(column, s);
 }
 
+// The basis matrices again, in floating point, so that the reference does not
+// depend on the engine's integer tables (seed 004; Catmull & Rom 1974).
+BasisMatrix4 ReferenceBasisMatrix(Basis basis) {
+  switch (basis) {
+    case Basis::kPower:
+      return {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}};
+    case Basis::kHermite:
+      return {{{2, -2, 1, 1}, {-3, 3, -2, -1}, {0, 0, 1, 0}, {1, 0, 0, 0}}};
+    case Basis::kBezier:
+      return {{{-1, 3, -3, 1}, {3, -6, 3, 0}, {-3, 3, 0, 0}, {1, 0, 0, 0}}};
+    case Basis::kBSpline: {
+      const double k = 1.0 / 6.0;
+      return {{{-k, 3 * k, -3 * k, k},
+               {3 * k, -6 * k, 3 * k, 0},
+               {-3 * k, 0, 3 * k, 0},
+               {k, 4 * k, k, 0}}};
+    }
+    case Basis::kCatmullRom:
+      return {{{-0.5, 1.5, -1.5, 0.5}, {1, -2.5, 2, -0.5}, {-0.5, 0, 0.5, 0}, {0, 1, 0, 0}}};
+  }
+  throw std::invalid_argument("unknown basis");
+}
+
 Point3 EvaluateReference(const Patch& patch, double s, double t) {
   if (patch.basis == Basis::kBezier) return EvaluateDeCasteljau(patch, s, t);
-  const Matrix4 m = ReferenceBasis(patch.basis);
+  const BasisMatrix4 m = ReferenceBasisMatrix(patch.basis);
   const std::array<double, 4> ws = Weights(m, s);
   const std::array<double, 4> wt = Weights(m, t);
   Point3 p{};
@@ -75,7 +73,7 @@ Point3 EvaluateReference(const Patch& patch, double s, double t) {
 }
 
 PowerCoefficients CoefficientsOf(const Patch& patch) {
-  const Matrix4 m = ReferenceBasis(patch.basis);
+  const BasisMatrix4 m = ReferenceBasisMatrix(patch.basis);
   PowerCoefficients result;
   for (int c = 0; c < 3; ++c) {
     double mg[4][4] = {};

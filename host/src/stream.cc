@@ -36,13 +36,6 @@ Vec InSteps(const Patch& patch, const StreamJob& job, double s, double t) {
   return ToSteps(EvaluateReference(patch, s, t), job);
 }
 
-// Where the device's stepper puts a coordinate of value v (2^-16 steps):
-// rounded half up, as RoundToQuanta does.
-std::int32_t RoundedStep(std::int64_t v) {
-  return static_cast<std::int32_t>((v + (std::int64_t{1} << (kCoefficientFracBits - 1))) >>
-                                   kCoefficientFracBits);
-}
-
 double Distance(const Vec& a, const Vec& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                    (a[2] - b[2]) * (a[2] - b[2]));
@@ -134,8 +127,9 @@ void AddCurves(const PatchSet& set, const ToolpathOptions& t, const MachineOptio
     std::array<std::int32_t, 3> end{};
     for (int a = 0; a < protocol::kMaxAxes; ++a) {
       const auto& k = power[a].c;
-      start[static_cast<std::size_t>(a)] = RoundedStep(k[3]);
-      end[static_cast<std::size_t>(a)] = RoundedStep(k[0] + k[1] + k[2] + k[3]);
+      start[static_cast<std::size_t>(a)] = RoundToQuanta(k[3], kCoefficientFracBits);
+      end[static_cast<std::size_t>(a)] =
+          RoundToQuanta(k[0] + k[1] + k[2] + k[3], kCoefficientFracBits);
     }
     if (!placed || start != at) {
       if (pen_down) pen(false);

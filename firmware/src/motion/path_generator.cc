@@ -20,15 +20,6 @@ void CopyGeometry(const CurveGeometry1 (&from)[protocol::kMaxAxes], CurveGeometr
   for (int c = 0; c < kDims; ++c) to[c] = from[c];
 }
 
-// The first point of a curve as the adaptive stepper rounds it: d/2^16 with
-// halves upward (fdsurf/int128.h, RoundToQuanta).
-int32_t StartOf(const PowerCurve1& axis) {
-  const uint64_t biased = static_cast<uint64_t>(axis.c[3]) + static_cast<uint64_t>(kHalfStep);
-  const uint64_t floor =
-      (biased >> 63) != 0 ? ~(~biased >> kCoefficientFracBits) : biased >> kCoefficientFracBits;
-  return internal::ToInt32(static_cast<uint32_t>(floor));
-}
-
 // Whether line `index` of `lines` in a family is an edge the command says
 // another patch draws.
 bool Skipped(uint8_t skip_lines, IsolineFamily family, uint16_t index, uint16_t lines) {
@@ -382,7 +373,8 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {
       case Stage::kLineStart: {
         bool there = true;
         for (int c = 0; c < kDims; ++c) {
-          line_start_[c] = StartOf(line_[c]);
+          // The first point as the stepper will round it.
+          line_start_[c] = RoundToQuanta(line_[c].c[3], kCoefficientFracBits);
           there = there && line_start_[c] == position_[c];
         }
         if (there) {

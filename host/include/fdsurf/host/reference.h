@@ -10,6 +10,12 @@
 
 namespace fdsurf::host {
 
+/// A basis matrix M in floating point (row r multiplies u^(3-r)), typed in
+/// again here so that the reference shares nothing with the engine's integer
+/// tables. Throws std::invalid_argument for a value outside the enum.
+using BasisMatrix4 = std::array<std::array<double, 4>, 4>;
+BasisMatrix4 ReferenceBasisMatrix(Basis basis);
+
 /// The point of `patch` at parameters (s, t), s, t in [0, 1].
 Point3 EvaluateReference(const Patch& patch, double s, double t);
 
