@@ -21,10 +21,10 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 echo "== clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
 
-echo "== clang-tidy (firmware/, host/, hal/, sim/, the test image's host build)"
+echo "== clang-tidy (firmware/, hal/, host/, sim/, tools/, the test image's host build)"
 # clang-tidy counts the (filtered-out) warnings of system headers on stderr;
 # show its output only when it fails.
-if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'targets/image/*.cc' \
+if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tools/*.cc' 'targets/image/*.cc' \
   'targets/port/host.cc' |
   xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
   echo "$tidy" | grep -v 'warnings generated'
