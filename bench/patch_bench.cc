@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Points per second for the teapot's bicubic grids: the fixed-point engine
 // against, in the same run, the double reference by Horner per point and by
 // de Casteljau per point, and the engine's own set-up cost.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Runs fdsurf_bench and prints the table of docs/performance.md.
 
 Every ratio is against the fixed engine's stepping measured in the same run,

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Adaptive vs fixed-step forward differencing on the teapot, for the same tolerance.
 
 Runs `fdsurf plot` in each mode and prints a markdown table of the points it

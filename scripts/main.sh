@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Sets everything up and runs fdsurf's main job on its default target, the
 # simulated plotter: streams the Utah teapot (examples/teapot.bpt) as 32
 # Bézier patches to the firmware running over the in-memory HAL, which draws

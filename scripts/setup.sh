@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Installs everything fdsurf needs on Debian 12 (run as root), then configures
 # and builds the project in build/. Safe to run again: apt-get skips what is
 # already installed and CMake rebuilds only what changed.

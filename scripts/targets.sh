@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds every microcontroller target, runs each image under its emulator
 # against the host reference, and prints the tables of docs/performance.md
 # ("Microcontrollers") from those runs. Needs scripts/setup.sh first.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Sets everything up (Debian packages, build) and runs every check: the test
 # suite, the same suite under AddressSanitizer + UndefinedBehaviorSanitizer,
 # clang-format and clang-tidy. Exits non-zero on the first failure.
@@ -26,7 +27,7 @@ echo "== clang-tidy (firmware/, hal/, host/, sim/, tools/, the test image's host
 # show its output only when it fails.
 if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tools/*.cc' 'targets/image/*.cc' \
   'targets/port/host.cc' |
-  xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
+  grep -v '/test/' | xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
   echo "$tidy" | grep -v 'warnings generated'
   exit 1
 fi

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The freestanding core may only need what a bare-metal C runtime provides
 # (memcpy, memset, compiler helpers): no heap, no exceptions, no RTTI, no C++
 # library, no stdio. Lists the core's undefined symbols and fails on any other.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Shared part of the Cortex-M toolchain files: Debian's arm-none-eabi-g++
 # (gcc-arm-none-eabi, libnewlib-arm-none-eabi). Include after setting
 # FDSURF_TARGET, FDSURF_CPU_FLAGS and FDSURF_TARGET_MEMORY.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Shared part of the AVR toolchain files; include after setting
 # FDSURF_TARGET, FDSURF_TARGET_MCU and FDSURF_TARGET_SETUP. avr-libc's start
 # files and linker script; -Os, as AVR firmware is built.

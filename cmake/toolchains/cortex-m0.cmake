@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Cortex-M0 (BBC micro:bit under QEMU -M microbit): no FPU, no divide instruction.
 # cmake -S . -B build/targets/cortex-m0 -G Ninja -DCMAKE_BUILD_TYPE=Release \
 #   -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/cortex-m0.cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Cortex-M3 (QEMU -M mps2-an385): no FPU.
 # cmake -S . -B build/targets/cortex-m3 -G Ninja -DCMAKE_BUILD_TYPE=Release \
 #   -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/cortex-m3.cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Cortex-M4F (QEMU -M mps2-an386): single-precision FPU, hard-float ABI.
 # cmake -S . -B build/targets/cortex-m4f -G Ninja -DCMAKE_BUILD_TYPE=Release \
 #   -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/cortex-m4f.cmake

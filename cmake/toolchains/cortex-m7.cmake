@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Cortex-M7 (QEMU -M mps2-an500): double-precision FPU, hard-float ABI.
 # cmake -S . -B build/targets/cortex-m7 -G Ninja -DCMAKE_BUILD_TYPE=Release \
 #   -DCMAKE_TOOLCHAIN_FILE=cmake/toolchains/cortex-m7.cmake

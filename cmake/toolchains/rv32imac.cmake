@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # RV32IMAC, ilp32 (QEMU -M virt), with Debian's riscv64-unknown-elf-gcc
 # (gcc-riscv64-unknown-elf). Freestanding: the toolchain has no C library, so
 # targets/port/riscv.cc provides start-up, semihosting and memcpy/memset.

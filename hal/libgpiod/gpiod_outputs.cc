@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/hal/gpiod_outputs.h"
 
 #include <gpiod.h>

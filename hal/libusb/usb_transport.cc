@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/hal/usb_transport.h"
 
 #include <libusb-1.0/libusb.h>

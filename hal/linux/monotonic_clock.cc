@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/hal/monotonic_clock.h"
 
 #include <time.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/hal/sim.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Compiles every interface header with the fdsurf_hal flags (C++14,
 // -ffreestanding -nostdinc++), so an accidental C++ library include fails the
 // build here rather than in a firmware port.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/hal/io_status.h"
 
 namespace fdsurf {

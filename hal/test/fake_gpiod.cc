@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fake_gpiod.h"
 
 #include <gpiod.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A fake libgpiod 1.6 for tests linked with -Wl,--wrap=<each gpiod function
 // the backend calls>: the backend's calls land in __wrap_* functions that
 // emulate chips with N lines, lines used by other consumers, missing chips

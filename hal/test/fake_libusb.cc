@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fake_libusb.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A fake libusb-1.0 for tests linked with -Wl,--wrap=<each libusb function the
 // backend calls> (libusb_error_name stays real): a list of devices that can
 // be unplugged and replugged elsewhere, and scripted bulk transfers.

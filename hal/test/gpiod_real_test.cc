@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // GpiodOutputs against the real libgpiod 1.6 (no --wrap): a chip that does
 // not exist must give the clear message through the library's own errno path.
 #include <gtest/gtest.h>

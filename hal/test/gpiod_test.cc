@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // GpiodOutputs against a fake libgpiod (fake_gpiod.cc, linked with
 // -Wl,--wrap): the exact line values after each call and every error message.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The Linux real-time clock: monotonic, and never wakes early.
 #include "fdsurf/hal/monotonic_clock.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The in-memory backend: recorded events with virtual timestamps, the
 // transport pair's delivery-time arithmetic, and unplugging.
 #include "fdsurf/hal/sim.h"

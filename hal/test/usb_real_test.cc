@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // UsbTransport against the real libusb (no --wrap): a VID:PID that no device
 // has. Without USB access (a container without /dev/bus/usb) libusb may
 // refuse to start; either way the message must say what happened.

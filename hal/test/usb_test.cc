@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // UsbTransport against a fake libusb (fake_libusb.cc, linked with -Wl,--wrap):
 // device selection, exact error messages, partial transfers, and a device
 // that disappears mid-transfer and comes back elsewhere.

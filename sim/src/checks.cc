@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/sim/checks.h"
 
 #include <algorithm>

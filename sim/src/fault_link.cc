@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/sim/fault_link.h"
 
 #include <algorithm>

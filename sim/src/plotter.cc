@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/sim/plotter.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The measured loops: the engine's steppers and the alternatives a firmware
 // author would otherwise write, all producing whole-quantum points from the
 // same cubic. Each loop runs between two PortMark() calls; the emulator counts

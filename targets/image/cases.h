@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fixed input set, set up with the engine and handed to a visitor (the
 // Reporter on every target; on the host also the table writer that feeds the
 // ATmega328P image, targets/tools/). Each item is marked small when it is part

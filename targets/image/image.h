@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The test image's entry point, shared by every target and the host reference.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fixed input set of the test image: Newell's teapot compiled in, and a
 // written-out xorshift generator for random geometry, so that every target
 // and the host reference see exactly the same numbers.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What the test image needs from the machine it runs on. Each target has one
 // implementation in targets/port/ (host, arm, riscv, avr); the image itself is
 // the same C++14 code everywhere, so its output can be compared bit for bit.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Text output and checksums of the test image. Everything the image prints is
 // a function of the engine's integer results, so the host reference and every
 // target must print the same bytes.

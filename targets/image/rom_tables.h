@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Host-prepared tables for images without the set-up code (ATmega328P: the
 // set-up alone exceeds its 32 KB of flash and 2 KB of RAM). The host reference
 // program writes them (fdsurf_image_host --emit-tables) from the same set-up

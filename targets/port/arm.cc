@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Cortex-M port of the test image for QEMU: a minimal vector table and reset
 // handler, ARM semihosting (bkpt 0xAB) for output and the exit status.
 #include <stddef.h>

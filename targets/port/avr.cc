@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // AVR port of the test image for simavr (targets/sim/simavr_run.c): the
 // report goes out on USART0, GPIOR1 is the measurement marker, and the exit
 // status is written to GPIOR2 before the CPU sleeps with interrupts off.

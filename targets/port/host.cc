@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The host reference: the same image code as the targets, built with the
 // host compiler, printing to stdout. Also writes the prepared tables of the
 // ATmega328P image (--emit-tables), from the same set-up code.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // RV32 port of the test image for QEMU's virt machine (-bios none): the
 // toolchain has no C library, so the start code, the semihosting calls and
 // the few memory functions the compiler may call are written here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The port functions of the ARM and RISC-V test images (targets/port/port.h),
 // on semihosting: the report a line at a time, the exit status, the painted
 // stack's high-water mark.

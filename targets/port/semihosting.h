@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What the ARM and RISC-V ports share: output and exit through semihosting
 // (the same operations on both; only the trap instruction differs), and a
 // painted stack for the high-water mark. Each port defines Semihost() and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* A QEMU TCG plugin that counts executed guest instructions and records the
  * count each time the guest reaches a marker address (the image's
  * fdsurf_image_mark, targets/port/). The cost of a measured loop is the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 /* Runs an AVR test image under simavr (libsimavr) and reports what the
  * firmware does through three channels (targets/port/avr.cc):
  *   USART0 output      -> copied to stdout, byte for byte;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Size group "device": the whole plotter firmware as an MCU build links it:
 // the engine (set-up, isoline walker, step-exact adaptive stepping), the wire
 // protocol (COBS/CRC-32 framing, the codec, DeviceLink), the command queue,

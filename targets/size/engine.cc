@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Size group "engine": set-up and stepping, everything a device that receives
 // geometry links: PreparePatch/PrepareCurve (2-D, 3-D), the adaptive set-up
 // and the isoline walker, and every stepper (size/stepping.cc).

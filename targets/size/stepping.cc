@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Size group "stepping": every stepper, as a device that receives prepared
 // tables links it (2-D and 3-D; 64- and 128-bit accumulators; curve, patch
 // and adaptive). Also the object the hot-path check inspects

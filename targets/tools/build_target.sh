@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Configures and builds one microcontroller target (cmake/toolchains/TARGET.cmake)
 # in DIR: the test image, the size images and the hot-path check.
 # Usage: build_target.sh TARGET DIR HOST_REFERENCE

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Fails when the stepping code calls a divide, multiply or floating-point
 # routine: the steppers must add, shift and compare only, on every target
 # (the set-up may divide; it is not in this object).

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Writes targets/image/teapot_table.cc from examples/teapot.bpt.
 
 Each coordinate becomes GeometryFixed raw units at Q = 0.001 (quanta with 16

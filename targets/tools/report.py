@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Prints the microcontroller tables of docs/performance.md from the results
 of the emulator runs (ctest --test-dir build -L targets writes them to
 build/targets/<target>/results/).

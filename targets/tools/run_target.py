@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Runs a target's test image under its emulator and checks it against the host.
 
 1. The host reference (fdsurf_image_host, --small for the ATmega328P) prints

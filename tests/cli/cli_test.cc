@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fdsurf tool as a user runs it: output on success, and on bad input a
 // message on stderr naming the file and place, a non-zero exit, empty stdout.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The firmware's motion side: the velocity profile of the motion loop, the
 // path generator's expansion of patches, curves and moves, and the device's
 // validation, STOP and faults. References are independent: exact curves in

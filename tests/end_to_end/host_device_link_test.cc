@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The device link (DeviceLink) and the host's reliable sender (HostLink),
 // end to end through the fault-injection link in virtual time.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The simulated plotter end to end: the teapot streamed as patches to the
 // firmware running over the in-memory HAL, read back from the recorded pins
 // and compared with the double reference; the same through a link that

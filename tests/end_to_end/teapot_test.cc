@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The teapot through the whole host path (file → quanta → engine) against the
 // double reference, and the engine's refusals as the host reports them.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // An exact rational reference for tests: integer geometry (in quanta), grid
 // parameters s = i/n, t = j/m, evaluated with native __int128 arithmetic and
 // the basis matrices typed in again here, so it shares nothing with the

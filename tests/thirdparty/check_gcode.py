@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Checks fdsurf's G-code by reading it back with a third-party interpreter.
 
 usage: check_gcode.py STROKES.json FILE.gcode

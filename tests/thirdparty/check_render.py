@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Renders fdsurf's SVG and HPGL with third-party programs and compares what they draw.
 
 usage: check_render.py STROKES.json --svg FILE.svg --hpgl FILE.hpgl

@@ -1,4 +1,5 @@
 #!/usr/bin/env node
+// SPDX-License-Identifier: MIT
 // Reads a G-code file with the npm package gcode-toolpath (cncjs's
 // interpreter on top of gcode-parser) and prints the motion segments it
 // produces as JSON: [{"motion": "G0"|"G1", "v1": [x,y,z], "v2": [x,y,z]}, ...].

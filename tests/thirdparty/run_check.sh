@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # One third-party check as a CTest test:
 #   run_check.sh FDSURF INPUT gcode|render [fdsurf plot options...]
 # Draws INPUT with `fdsurf plot` (the strokes as JSON, and the G-code, or the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Option parsing and output staging shared by the fdsurf commands.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "construct_commands.h"
 
 #include <cmath>

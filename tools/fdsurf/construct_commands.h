@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The parts of fdsurf sample/check that handle curves and construction notes,
 // and the joins command (docs/constructions.md).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // fdsurf: the command-line tool. Every command validates its whole input
 // before it writes anything, so an error leaves stdout empty.
 #include <unistd.h>

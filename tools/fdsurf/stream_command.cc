@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "stream_command.h"
 
 #include <CLI/CLI.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // `fdsurf stream`: plans a drawing, streams it as patches to a device (the
 // simulated plotter, a USB controller, or GPIO lines driven from this host)
 // and reports what happened.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Instantiates the device under the core's freestanding flags, so that the
 // header-only firmware is held to the same rules as the .cc files (and the
 // freestanding-symbols check sees everything it links).

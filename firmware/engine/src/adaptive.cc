@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Set-up of adaptive curves and of the isoline walker. docs/toolpaths.md
 // derives the level choice, the range bound and the chord test used here.
 #include "fdsurf/adaptive.h"

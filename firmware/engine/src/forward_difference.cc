@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Set-up of the forward-difference tables and the precision planner.
 //
 // Everything here is exact integer arithmetic; docs/precision.md derives each

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Instantiates every stepper template under the core's freestanding flags, so
 // that header-only code is held to the same rules as the .cc files.
 #include "fdsurf/adaptive.h"

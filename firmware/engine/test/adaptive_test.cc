@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Adaptive forward differencing and the isoline walker against exact and
 // independent references: every point is the exactly rounded value of the
 // prepared curve, every chord is within the tolerance of the original curve

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The core's integer types against the compiler's native __int128.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The fixed-point engine against the exact rational reference
 // (exact_reference.h): every emitted point within 0.51 quanta, for every
 // basis, many grids, and geometry at the edge of the supported range.

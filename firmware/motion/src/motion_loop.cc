@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/motion/motion_loop.h"
 
 namespace fdsurf {

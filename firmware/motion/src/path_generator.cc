@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/motion/path_generator.h"
 
 namespace fdsurf {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/protocol/crc32.h"
 
 namespace fdsurf {

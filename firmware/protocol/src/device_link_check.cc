@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Instantiates DeviceLink under the core's freestanding flags with a minimal
 // sink, so the header-only link is compiled (and held to the same rules) in
 // every build of the core.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/protocol/frame.h"
 
 namespace fdsurf {

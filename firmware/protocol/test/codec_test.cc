@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Message codec of the device protocol: round trips, every validation
 // refusal with its documented field index, the worked example of
 // docs/protocol.md, and a fuzz of the decoders with CRC-valid random bodies.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CRC-32 and COBS framing of the device protocol (firmware/include/fdsurf/protocol).
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/quadric_hermite.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Constructions (docs/constructions.md): every test checks a defining property
 // against the construction's formula evaluated here again in double, not
 // against the code under test, and the engine's bound on the result.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/fixed_curve.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/quantum.h"
 
 #include <cmath>

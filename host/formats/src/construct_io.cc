@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "construct_io.h"
 
 #include <cmath>

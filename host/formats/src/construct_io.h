@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // JSON input shared by the readers, and the JSON "construct" and "curves" arrays (docs/formats.md,
 // docs/constructions.md). Private to the host library: patch_io.cc calls it.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/patch_io.h"
 
 #include <cctype>

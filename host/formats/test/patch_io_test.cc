@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Reading BPT and JSON, and the quantum's exact decimal form.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/link.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The double-precision reference: against exact rational values, and the
 // defining properties of each basis.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 #include "fdsurf/host/writers.h"
 
 #include <cairo.h>

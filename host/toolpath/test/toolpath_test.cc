@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Toolpaths against the double reference: every emitted point and every chord
 // of every isoline within the tolerance of the exact curve (measured densely),
 // for the teapot and random patches of every basis, in several views, in 2-D

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Adaptive forward differencing of cubic curves and of the isoparametric
 // curves of bicubic patches.
 //

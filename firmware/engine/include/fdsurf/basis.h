@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The cubic bases the engine evaluates, as exact integer matrices.
 //
 // A patch is x(s,t) = S·M·G·Mᵀ·Tᵀ with S = [s³ s² s 1]. Every basis matrix M

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Fixed-point numbers with the format in the type.
 //
 // A Fixed<Rep, kFracBits> holds value * 2^kFracBits in a signed integer Rep.

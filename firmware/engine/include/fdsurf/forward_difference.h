@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Forward-difference evaluation of cubic curves and bicubic patches.
 //
 // Set-up (Prepare*) forms the difference matrix DD = E(δ)·C·E(ε)ᵀ exactly in

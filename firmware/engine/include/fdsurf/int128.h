@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The accumulator types of the stepping loop.
 //
 // Differences are held as integers in units of 2^-F quanta (F chosen by the

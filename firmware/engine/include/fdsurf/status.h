@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Error codes of the fdsurf core. The core has no exceptions: every fallible
 // call returns a Status and leaves its outputs untouched on failure.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A monotonic microsecond clock for the motion loop: real (CLOCK_MONOTONIC on
 // Linux, a timer on an MCU) or virtual (the simulator).
 //

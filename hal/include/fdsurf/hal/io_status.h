@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The result of every call across the hardware boundary (transport, outputs).
 // Freestanding: the firmware side uses it on an MCU, so no C++ library here.
 #pragma once

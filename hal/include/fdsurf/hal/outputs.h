@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Output-only hardware: the step/dir/enable lines of 2 or 3 stepper drivers
 // (A4988, DRV8825, TMC2208 in step/dir mode, ...) and the pen.
 //

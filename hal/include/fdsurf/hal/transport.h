@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // A byte link to the other end: USB bulk endpoints, an in-memory pair, later
 // perhaps a UART. The wire protocol frames its messages itself (COBS), so a
 // transport only moves bytes and reports failures.

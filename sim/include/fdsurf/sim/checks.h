@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // What the simulated plotter checks about a run, from the recorded pin events
 // alone: how far the drawing is from the exact (double-precision) curves, and
 // whether the motion kept the machine's limits.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Fault injection for byte streams of 0x00-delimited frames, and a minimal
 // in-memory pipe with latency, for testing the device protocol in virtual
 // time.

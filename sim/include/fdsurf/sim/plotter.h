@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The simulated plotter: the firmware's Device, unchanged, over the in-memory
 // HAL (virtual clock, recorded step/dir and pen events, a transport pair with
 // latency and bandwidth), co-simulated with the host's HostLink in virtual

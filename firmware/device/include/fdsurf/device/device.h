@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The plotter firmware: the protocol endpoint, a fixed-capacity command queue,
 // the path generator and the motion loop, driven through the HAL interfaces
 // only, so the same code runs in the simulator, on a Linux host (GPIO) and on

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Fixed-width signed integers for the one-time set-up arithmetic.
 //
 // Forming the difference matrix exactly needs products of about 180 bits

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Entries of the motion loop's lookahead buffer: one byte each, a unit move
 // (every axis −1, 0 or +1 step) or an event (pen up, pen down, end of a
 // command).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The motion loop: a lookahead buffer of unit moves and pen events, and the
 // per-tick velocity profile that turns them into step pulses.
 //

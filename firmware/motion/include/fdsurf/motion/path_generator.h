@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Expands queued commands (patches, curves, straight moves, pen changes) into
 // the motion loop's entries: unit moves and pen events.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Encoding and validating decoding of every message in messages.h.
 //
 // Bodies are little-endian. Geometry values (Q47.16 raw) are zigzag LEB128

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // CRC-32 as in IEEE 802.3 (the CRC of zlib, PNG and Ethernet): reflected
 // polynomial 0xEDB88320, initial value and final XOR 0xFFFFFFFF. The check
 // value of the ASCII string "123456789" is 0xCBF43926 (the "CRC-32" entry of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The device's end of the link: frames in, replies out, sequencing,
 // acknowledgements and credits. docs/protocol.md gives the rules; in short:
 //

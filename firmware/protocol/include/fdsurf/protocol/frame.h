@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Framing: COBS-encoded frames, each followed by a 0x00 delimiter.
 //
 // Consistent Overhead Byte Stuffing (S. Cheshire and M. Baker, "Consistent

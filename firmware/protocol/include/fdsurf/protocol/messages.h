@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The device protocol's messages, decoded: what the host asks the device to
 // do, and what the device answers. docs/protocol.md gives the wire format
 // (COBS frames with a CRC-32, sequence numbers, acknowledgements, credits);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Step/dir/enable and pen lines driven by the host itself through the Linux
 // GPIO character device, with Debian 12's libgpiod 1.6 (the v1 C API).
 //

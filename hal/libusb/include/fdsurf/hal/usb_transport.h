@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The host side of a USB link to a controller: one vendor-specific interface
 // with a bulk OUT and a bulk IN endpoint, through libusb-1.0.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The real-time clock of a Linux host: CLOCK_MONOTONIC, slept on with
 // clock_nanosleep(TIMER_ABSTIME) so that sleeps do not drift.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The in-memory backend: a virtual clock, step/dir and pen outputs that record
 // timestamped events, and a pair of connected transports with latency,
 // bandwidth and unplugging. Nothing here blocks or reads the real time, so the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Curve and surface constructions from the source documents (seeds 001-004),
 // each turned into cubic curves or bicubic patches that the fixed-point engine
 // evaluates. Formulas, sources and bounds: docs/constructions.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Piecewise quadric Hermite interpolation over a triangulation (seed 000):
 // for each triangle a second-order surface F(x,y,z) = 0 through its three
 // vertices whose normals there are parallel to the given vectors; neighbouring

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Host glue for curves: a double-precision cubic curve converted to the
 // engine's geometry format and stepped by the core's CurveStepper, exactly as
 // fixed_engine.h does for patches.

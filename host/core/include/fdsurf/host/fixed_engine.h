@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Host glue for the fixed-point engine: converts a double-precision patch to
 // the engine's geometry format for a quantum, plans it, and steps it with the
 // accumulator width the plan chose.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Patch sets as read from files: bicubic patches in double precision, in the
 // units of the file, each remembering where it came from for error messages.
 #pragma once

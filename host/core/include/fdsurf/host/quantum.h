@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The output quantum Q: a positive decimal, kept exact so positions can be
 // printed as their exact decimal value k·Q.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Small vector arithmetic on Point3 for the host's geometry code.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Reading patch files: BPT text and fdsurf JSON (docs/formats.md).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The host's end of the device link: a reliable, in-order, exactly-once
 // sender of sequenced commands over an unreliable byte stream (go-back-N
 // with cumulative ACKs, NAK-triggered fast retransmission, credit-based flow

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // The double-precision reference evaluation.
 //
 // Shares no code with the fixed-point engine: Bézier patches are evaluated by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Jobs for a device: the drawing as patches in motor steps, ready to stream.
 //
 // The host does what needs the whole drawing (the view, the fit to the page,

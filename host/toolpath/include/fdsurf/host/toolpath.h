@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Toolpaths: patch sets drawn as wireframes of isoparametric curves.
 //
 // Each patch is mapped affinely into output space (a view's projection, a

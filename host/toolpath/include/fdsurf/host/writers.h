@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: MIT
 // Writers for planned toolpaths: SVG, G-code, HPGL, the strokes as JSON, and a
 // PNG picture (cairo). The text writers return the whole file as a string,
 // so that a caller can produce everything before it writes anything.
