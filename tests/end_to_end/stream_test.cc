@@ -28,7 +28,7 @@ const host::PatchSet& Teapot() {
 // 3×3 lines a patch, 0.0125 mm steps, 250 mm/s.
 host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250) {
   host::ToolpathOptions options;
-  options.view = host::ParseView("iso");
+  options.view = *host::NamedView("iso");
   options.fit = std::array<double, 2>{24, 18};
   options.margin = 1;
   options.lines_s = 3;
@@ -235,7 +235,7 @@ TEST(SimulatedPlotter, StreamsTheCurvesOfAFileAsChains) {
   const host::PatchSet set =
       host::ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/hermite-chain.json");
   host::ToolpathOptions options;
-  options.view = host::ParseView("top");
+  options.view = *host::NamedView("top");
   options.fit = std::array<double, 2>{60, 40};
   options.margin = 2;
   options.tolerance = 0.02;

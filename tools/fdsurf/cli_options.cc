@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -11,8 +12,7 @@
 #include <cstring>
 
 #include "fdsurf/forward_difference.h"
-#include "fdsurf/host/patch_io.h"
-#include "fdsurf/host/writers.h"
+#include "fdsurf/host/errors.h"
 
 namespace fdsurf::host {
 
@@ -57,6 +57,41 @@ std::array<double, 2> ParsePage(const std::string& text, const std::string& what
   if (x == std::string::npos) throw InputError(what + ": '" + text + "' is not WxH (like 200x150)");
   return {ParsePositive(text.substr(0, x), what + " width"),
           ParsePositive(text.substr(x + 1), what + " height")};
+}
+
+View ParseView(const std::string& text) {
+  if (const std::optional<View> named = NamedView(text)) return *named;
+  const std::size_t comma = text.find(',');
+  double az = 0;
+  double el = 0;
+  std::size_t used_az = 0;
+  std::size_t used_el = 0;
+  bool ok = comma != std::string::npos;
+  try {
+    if (ok) {
+      az = std::stod(text.substr(0, comma), &used_az);
+      el = std::stod(text.substr(comma + 1), &used_el);
+    }
+  } catch (const std::exception&) {
+    ok = false;
+  }
+  ok = ok && used_az == comma && used_el == text.size() - comma - 1 && std::isfinite(az) &&
+       std::isfinite(el);
+  if (!ok) {
+    throw InputError("--view: '" + text +
+                     "' is not a view: use top, front, side, iso or AZ,EL in degrees");
+  }
+  return ViewFromAngles(text, az, el);
+}
+
+std::string FlagFor(const std::string& field) {
+  std::string flag = "--" + field;
+  // "pen delay" is --pen-delay; "travel X" stays "--travel X" (the axis of
+  // the one --travel option).
+  if (field.find(' ') != std::string::npos && field.rfind("travel ", 0) != 0) {
+    std::replace(flag.begin(), flag.end(), ' ', '-');
+  }
+  return flag;
 }
 
 StagedOutputs::~StagedOutputs() {

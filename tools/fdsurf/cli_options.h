@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "fdsurf/host/toolpath.h"
+
 namespace fdsurf::host {
 
 /// A number > 0 (or ≥ 0 with allow_zero); InputError naming `what` otherwise.
@@ -17,6 +19,15 @@ std::array<int, 2> ParseLines(const std::string& text);
 
 /// "WxH" with both > 0; `what` names the option in errors.
 std::array<double, 2> ParsePage(const std::string& text, const std::string& what = "--fit");
+
+/// --view: "top", "front", "side", "iso" or "AZ,EL" in degrees (azimuth
+/// from +x towards +y of the eye's direction, elevation above the xy plane).
+/// Throws InputError or OptionError ("view").
+View ParseView(const std::string& text);
+
+/// The command-line flag of a library option field (OptionError::field):
+/// "tolerance" is --tolerance, "pen delay" --pen-delay, "travel X" --travel X.
+std::string FlagFor(const std::string& field);
 
 /// Whether to draw a progress line: stderr is a terminal, not quiet, not CI.
 bool ShowProgress(bool quiet);

@@ -17,6 +17,7 @@
 #include "fdsurf/host/fixed_engine.h"
 #include "fdsurf/host/link.h"
 #include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/plan.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/host/writers.h"
 #include "fdsurf/protocol/codec.h"
@@ -161,7 +162,7 @@ std::size_t GcodeBytes(const PatchSet& set, const ToolpathOptions& drawing,
   t.mode = StepMode::kAdaptive;
   t.quantum = Quantum::Parse(units == "in" ? "0.0001" : "0.001");
   Toolpath path = BuildToolpath(set, t, units);
-  PlanStrokes(&path);
+  PlanStrokes(set, &path);
   return WriteGcode(path, GcodeOptions{}, {}).size();
 }
 

@@ -10,20 +10,18 @@ PreparedCurve<3> PrepareFixedCurve(const Curve& curve, const Quantum& quantum, i
                                    const PrepareOptions& options) {
   static const char* const kAxisNames[3] = {"x", "y", "z"};
   CurveGeometry1 geometry[3];
-  const double limit = std::ldexp(1.0, 31);
   for (int k = 0; k < 4; ++k) {
     for (int c = 0; c < 3; ++c) {
       const double v = curve.g[k][c];
-      const double q = quantum.ToQuanta(v);
-      if (!std::isfinite(v) || !(std::fabs(q) < limit)) {
+      const std::optional<GeometryFixed> g = ToGeometry(v, quantum);
+      if (!g) {
         std::ostringstream why;
         why << curve.origin << ": geometry [" << k << "]." << kAxisNames[c] << " = " << v << " is "
             << (std::isfinite(v) ? "out of range" : "not finite") << ": at quantum "
             << quantum.Format(1) << " values must stay below 2^31 quanta in magnitude";
         throw EngineError(why.str());
       }
-      geometry[c].g[k] = GeometryFixed::FromRaw(
-          static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
+      geometry[c].g[k] = *g;
     }
   }
   if (steps < 1 || steps > kMaxCurveSteps) {
@@ -36,7 +34,7 @@ PreparedCurve<3> PrepareFixedCurve(const Curve& curve, const Quantum& quantum, i
   if (status != Status::kOk) {
     throw EngineError(curve.origin + ": the fixed-point engine cannot evaluate this curve in " +
                       std::to_string(steps) + " steps: " + StatusMessage(status) +
-                      "; use a larger --quantum");
+                      "; use a larger quantum");
   }
   return prepared;
 }

@@ -36,11 +36,11 @@ std::string Explain(Status status, const Patch& patch, int steps_s, int steps_t,
       break;
     case Status::kGeometryOutOfRange:
       why << "the sum of its power coefficients, which bounds the surface, reaches ±2^31 "
-             "quanta (the output range); use a larger --quantum";
+             "quanta (the output range); use a larger quantum";
       break;
     case Status::kPrecisionUnreachable:
       why << "its differences need more than " << int{options.max_acc_bits}
-          << " accumulator bits for the 0.51-quantum bound; use a larger --quantum or a "
+          << " accumulator bits for the 0.51-quantum bound; use a larger quantum or a "
              "smaller grid";
       break;
     default:
@@ -55,13 +55,12 @@ PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, i
                                    int steps_t, const PrepareOptions& options) {
   PatchGeometry1 geometry[3];
   // Checked here, before any rounding, so the message can name the value.
-  const double limit = std::ldexp(1.0, 31);
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
       for (int c = 0; c < 3; ++c) {
         const double v = patch.g[i][j][c];
-        const double q = quantum.ToQuanta(v);
-        if (!std::isfinite(v) || !(std::fabs(q) < limit)) {
+        const std::optional<GeometryFixed> g = ToGeometry(v, quantum);
+        if (!g) {
           std::ostringstream why;
           why << patch.origin << ": geometry [" << i << "][" << j << "]." << kAxisNames[c] << " = "
               << v << " is " << (std::isfinite(v) ? "out of range" : "not finite")
@@ -69,8 +68,7 @@ PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, i
               << " values must stay below 2^31 quanta in magnitude";
           throw EngineError(why.str());
         }
-        const double raw = std::nearbyint(std::ldexp(q, kGeometryFracBits));
-        geometry[c].g[i][j] = GeometryFixed::FromRaw(static_cast<std::int64_t>(raw));
+        geometry[c].g[i][j] = *g;
       }
     }
   }

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/errors.h"
 
 namespace fdsurf::host {
 
@@ -64,6 +64,15 @@ std::string Quantum::Format(std::int64_t k) const {
     digits.insert(digits.size() - static_cast<std::size_t>(decimals_), 1, '.');
   }
   return (negative && magnitude != 0 ? "-" : "") + digits;
+}
+
+std::optional<GeometryFixed> ToGeometry(double value, const Quantum& quantum) {
+  const double q = quantum.ToQuanta(value);
+  // Checked in double first: a cast of a value beyond int64 is undefined.
+  if (!std::isfinite(q) || !(std::fabs(q) < std::ldexp(1.0, 31))) return std::nullopt;
+  const auto raw = static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits)));
+  if (!(raw > -kGeometryLimitRaw && raw < kGeometryLimitRaw)) return std::nullopt;
+  return GeometryFixed::FromRaw(raw);
 }
 
 }  // namespace fdsurf::host

@@ -167,14 +167,14 @@ TEST(Quantum, ParsesAndPrintsExactDecimals) {
   EXPECT_EQ(Quantum::Parse("2").Format(-7), "-14");
   EXPECT_EQ(Quantum::Parse("2.5").Format(3), "7.5");
   EXPECT_DOUBLE_EQ(Quantum::Parse("0.001").ToQuanta(1.4), 1400.0);
-  EXPECT_EQ(ErrorOf([] { Quantum::Parse("0"); }), "--quantum: '0' must be greater than zero");
+  EXPECT_EQ(ErrorOf([] { Quantum::Parse("0"); }), "quantum: '0' must be greater than zero");
   EXPECT_EQ(ErrorOf([] { Quantum::Parse("-1"); }),
-            "--quantum: '-1' is not a positive decimal number (like 0.001)");
+            "quantum: '-1' is not a positive decimal number (like 0.001)");
   EXPECT_EQ(ErrorOf([] { Quantum::Parse("1e-3"); }),
-            "--quantum: '1e-3' is not a positive decimal number (like 0.001)");
+            "quantum: '1e-3' is not a positive decimal number (like 0.001)");
   EXPECT_EQ(ErrorOf([] { Quantum::Parse("0.0000000001"); }),
-            "--quantum: '0.0000000001' has more than 9 decimals");
-  EXPECT_EQ(ErrorOf([] { Quantum::Parse("1.2.3"); }), "--quantum: '1.2.3' is not a decimal number");
+            "quantum: '0.0000000001' has more than 9 decimals");
+  EXPECT_EQ(ErrorOf([] { Quantum::Parse("1.2.3"); }), "quantum: '1.2.3' is not a decimal number");
 }
 
 }  // namespace

@@ -2,25 +2,20 @@
 #include "fdsurf/host/stream.h"
 
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <map>
 
 #include "fdsurf/adaptive.h"
 #include "fdsurf/host/constructions.h"
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/fixed_engine.h"
-#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/plan.h"
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/text.h"
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf::host {
 namespace {
-
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
 
 using Vec = std::array<double, 3>;
 
@@ -54,40 +49,98 @@ std::array<Vec, 2> Ends(const Patch& patch, const StreamJob& job, int lines_s, i
   return {start, InSteps(patch, job, 1, reversed ? 0 : 1)};
 }
 
-// An edge line a patch draws (s-line at s = 0 or 1, t-line at t = 0 or 1),
-// sampled at 9 parameters.
-using EdgeSamples = std::array<Vec, 9>;
-
-EdgeSamples SampleEdge(const Patch& patch, const StreamJob& job, int edge) {
-  EdgeSamples samples;
-  const double fixed = edge % 2 == 0 ? 0.0 : 1.0;
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    const double u = static_cast<double>(k) / (samples.size() - 1);
-    samples[k] = edge < 2 ? InSteps(patch, job, fixed, u) : InSteps(patch, job, u, fixed);
-  }
-  return samples;
-}
-
-// Two patches that share an edge have the same control points along it, so
-// the samples agree (up to rounding), forwards or backwards.
-bool SameCurve(const EdgeSamples& a, const EdgeSamples& b) {
-  constexpr double kSame = 0.1;  // steps
-  bool forward = true;
-  bool backward = true;
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    forward = forward && Distance(a[k], b[k]) <= kSame;
-    backward = backward && Distance(a[k], b[a.size() - 1 - k]) <= kSame;
-  }
-  return forward || backward;
-}
-
-std::int32_t ToSteps(double length, const Quantum& step, const std::string& what) {
+std::int32_t TravelSteps(double length, const Quantum& step, const std::string& units,
+                         const std::string& field) {
   const double steps = std::floor(length / step.value() + 1e-9);
   if (!(steps >= 1 && steps <= protocol::kMaxTravelSteps)) {
-    throw InputError(what + ": " + Number(length) + " is not 1.." +
-                     std::to_string(protocol::kMaxTravelSteps) + " steps of " + step.Format(1));
+    throw OptionError(
+        field, FormatNumber(length) + " " + units,
+        "is not 1.." + std::to_string(protocol::kMaxTravelSteps) + " steps of " + step.Format(1));
   }
   return static_cast<std::int32_t>(steps);
+}
+
+// The machine configuration: travel (the page's unless given), steps per
+// meter, speed and acceleration in steps, the pen delay.
+protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath& page,
+                                  const std::string& units) {
+  protocol::MachineConfig config{};
+  config.axes = static_cast<std::uint8_t>(page.dims);
+  const double step = machine.step.value();
+  const double extent[3] = {page.width, page.height, page.depth};
+  const char* const fields[3] = {"travel X", "travel Y", "travel Z"};
+  for (int c = 0; c < 3; ++c) {
+    config.steps_per_meter[c] = 0;
+    config.travel_steps[c] = 0;
+    if (c >= page.dims) continue;
+    const double travel = machine.travel[c] > 0 ? machine.travel[c] : std::max(extent[c], step);
+    if (travel < extent[c] - 1e-9) {
+      throw OptionError(fields[c], FormatNumber(travel) + " " + units,
+                        "is smaller than the page (" + FormatNumber(extent[c]) + " " + units + ")");
+    }
+    config.travel_steps[c] = TravelSteps(travel, machine.step, units, fields[c]);
+    const double meters = step * (units == "in" ? 0.0254 : 0.001);
+    config.steps_per_meter[c] = static_cast<std::uint32_t>(std::lround(1 / meters));
+  }
+  const double max_rate = std::floor(machine.speed / step);
+  const double accel = std::floor(machine.accel / step);
+  if (!(max_rate >= 1 && max_rate < 4e9)) {
+    throw OptionError("speed", FormatNumber(machine.speed) + " " + units + "/s",
+                      "is not 1 step/s or more");
+  }
+  if (!(accel >= 1 && accel < 4e9)) {
+    throw OptionError("accel", FormatNumber(machine.accel) + " " + units + "/s²",
+                      "is not 1 step/s² or more");
+  }
+  if (machine.pen_delay_ms < 0 || machine.pen_delay_ms > 65535) {
+    throw OptionError("pen delay", std::to_string(machine.pen_delay_ms) + " ms",
+                      "is outside 0..65535");
+  }
+  config.max_rate = static_cast<std::uint32_t>(max_rate);
+  config.accel = static_cast<std::uint32_t>(accel);
+  config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
+  return config;
+}
+
+// The PATCH command of one patch; its edge lines that an earlier patch drew
+// (found in `drawn`) are left out through skip_lines.
+protocol::Command PatchCommandFor(const Patch& patch, const ToolpathOptions& t,
+                                  const MachineOptions& machine, StreamJob* job,
+                                  DrawnCurves* drawn) {
+  protocol::Command command;
+  command.type = protocol::MessageType::kPatch;
+  command.seq = 0;
+  protocol::PatchCommand& body = command.body.patch;
+  body.basis = patch.basis;
+  body.dims = static_cast<std::uint8_t>(t.dims);
+  body.lines_s = static_cast<std::uint16_t>(t.lines_s);
+  body.lines_t = static_cast<std::uint16_t>(t.lines_t);
+  body.tolerance_q8 = job->tolerance_q8;
+  for (auto& axis : body.geometry) axis = PatchGeometry1{};
+  PatchToQuanta(patch, job->page.map, machine.step, t.dims, body.geometry);
+  body.skip_lines = 0;
+  struct Edge {
+    IsolineFamily family;
+    double at;
+    std::uint8_t skip_bit;
+  };
+  static constexpr Edge kEdges[4] = {
+      {IsolineFamily::kSLines, 0.0, protocol::kSkipFirstSLine},
+      {IsolineFamily::kSLines, 1.0, protocol::kSkipLastSLine},
+      {IsolineFamily::kTLines, 0.0, protocol::kSkipFirstTLine},
+      {IsolineFamily::kTLines, 1.0, protocol::kSkipLastTLine},
+  };
+  for (const Edge& edge : kEdges) {
+    if ((edge.family == IsolineFamily::kSLines ? t.lines_s : t.lines_t) < 2) continue;
+    const SampledCurve samples =
+        SampleIsoline(patch, job->page.map, machine.step.value(), t.dims, edge.family, edge.at);
+    if (IsPoint(samples)) continue;  // a pole: the device leaves it out anyway
+    if (drawn->CheckAndAdd(samples)) {
+      body.skip_lines = static_cast<std::uint8_t>(body.skip_lines | edge.skip_bit);
+      ++job->shared_edges_skipped;
+    }
+  }
+  return command;
 }
 
 // The file's curves, in file order: CURVE commands with the pen down, and a
@@ -122,7 +175,7 @@ void AddCurves(const PatchSet& set, const ToolpathOptions& t, const MachineOptio
     PowerCurve1 power[protocol::kMaxAxes];
     const Status status = CurvePowerCoefficients(body.geometry, curve.basis, power);
     if (status != Status::kOk) {
-      throw EngineError(curve.origin + ": " + StatusMessage(status) + "; use a coarser --step");
+      throw EngineError(curve.origin + ": " + StatusMessage(status) + "; use a coarser step");
     }
     std::array<std::int32_t, 3> start{};
     std::array<std::int32_t, 3> end{};
@@ -161,130 +214,33 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   t.quantum = machine.step;
   StreamJob job;
   job.page = PlanPage(set, t, units);
-  const double step = machine.step.value();
   if (t.dims == 3) {
     // The device's axes run from 0: put the bottom of the surface at Z = 0.
     job.page.map.offset[2] += job.page.depth;
   }
-
-  // The machine.
-  protocol::MachineConfig& config = job.config;
-  config.axes = static_cast<std::uint8_t>(t.dims);
-  const double page[3] = {job.page.width, job.page.height, job.page.depth};
-  const char* const names[3] = {"--travel X", "--travel Y", "--travel Z"};
-  for (int c = 0; c < 3; ++c) {
-    config.steps_per_meter[c] = 0;
-    config.travel_steps[c] = 0;
-    if (c >= t.dims) continue;
-    const double travel = machine.travel[c] > 0 ? machine.travel[c] : std::max(page[c], step);
-    if (travel < page[c] - 1e-9) {
-      std::string message = names[c];
-      message += " " + Number(travel) + " " + units;
-      message += " is smaller than the page (" + Number(page[c]) + " " + units + ")";
-      throw InputError(message);
-    }
-    config.travel_steps[c] = ToSteps(travel, machine.step, names[c]);
-    const double meters = step * (units == "in" ? 0.0254 : 0.001);
-    config.steps_per_meter[c] = static_cast<std::uint32_t>(std::lround(1 / meters));
-  }
-  const double max_rate = std::floor(machine.speed / step);
-  const double accel = std::floor(machine.accel / step);
-  if (!(max_rate >= 1 && max_rate < 4e9)) {
-    throw InputError("--speed " + Number(machine.speed) + " " + units +
-                     "/s is not 1 step/s or more");
-  }
-  if (!(accel >= 1 && accel < 4e9)) {
-    throw InputError("--accel " + Number(machine.accel) + " " + units +
-                     "/s² is not 1 step/s² or more");
-  }
-  if (machine.pen_delay_ms < 0 || machine.pen_delay_ms > 65535) {
-    throw InputError("--pen-delay " + std::to_string(machine.pen_delay_ms) +
-                     " ms is outside 0..65535");
-  }
-  config.max_rate = static_cast<std::uint32_t>(max_rate);
-  config.accel = static_cast<std::uint32_t>(accel);
-  config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
-
-  job.tolerance_steps = t.tolerance / step;
+  job.config = ConfigFor(machine, job.page, units);
+  job.tolerance_steps = t.tolerance / machine.step.value();
   job.tolerance_q8 =
       static_cast<std::uint32_t>(std::min(std::floor(job.tolerance_steps * 256), 4294967295.0));
 
   protocol::Command configure;
   configure.type = protocol::MessageType::kConfig;
   configure.seq = 0;
-  configure.body.config = config;
+  configure.body.config = job.config;
   job.commands.push_back(configure);
   job.labels.emplace_back("the machine configuration");
 
-  // The patches, nearest neighbour first from the origin.
-  const std::size_t n = set.patches.size();
-  std::vector<std::array<Vec, 2>> ends(n);
-  for (std::size_t p = 0; p < n; ++p) ends[p] = Ends(set.patches[p], job, t.lines_s, t.lines_t);
-  std::vector<bool> done(n, false);
-  // Edges drawn so far, found by their rounded end points.
-  std::multimap<std::array<std::int64_t, 6>, EdgeSamples> drawn_edges;
-  const auto edge_key = [](const EdgeSamples& e) {
-    std::array<std::int64_t, 3> a{};
-    std::array<std::int64_t, 3> b{};
-    for (int c = 0; c < 3; ++c) {
-      a[c] = std::llround(e.front()[static_cast<std::size_t>(c)]);
-      b[c] = std::llround(e.back()[static_cast<std::size_t>(c)]);
-    }
-    if (b < a) std::swap(a, b);
-    return std::array<std::int64_t, 6>{a[0], a[1], a[2], b[0], b[1], b[2]};
-  };
-  Vec pen{0, 0, 0};
-  for (std::size_t k = 0; k < n; ++k) {
-    std::size_t best = 0;
-    double best_distance = HUGE_VAL;
-    for (std::size_t p = 0; p < n; ++p) {
-      if (done[p]) continue;
-      const double d = Distance(pen, ends[p][0]);
-      if (d < best_distance) {
-        best_distance = d;
-        best = p;
-      }
-    }
-    done[best] = true;
-    pen = ends[best][1];
-
-    const Patch& patch = set.patches[best];
-    protocol::Command command;
-    command.type = protocol::MessageType::kPatch;
-    command.seq = 0;
-    protocol::PatchCommand& body = command.body.patch;
-    body.basis = patch.basis;
-    body.dims = static_cast<std::uint8_t>(t.dims);
-    body.lines_s = static_cast<std::uint16_t>(t.lines_s);
-    body.lines_t = static_cast<std::uint16_t>(t.lines_t);
-    body.tolerance_q8 = job.tolerance_q8;
-    for (auto& axis : body.geometry) axis = PatchGeometry1{};
-    PatchToQuanta(patch, job.page.map, machine.step, t.dims, body.geometry);
-    body.skip_lines = 0;
-    const std::uint8_t bits[4] = {protocol::kSkipFirstSLine, protocol::kSkipLastSLine,
-                                  protocol::kSkipFirstTLine, protocol::kSkipLastTLine};
-    for (int edge = 0; edge < 4; ++edge) {
-      if ((edge < 2 ? t.lines_s : t.lines_t) < 2) continue;
-      const EdgeSamples samples = SampleEdge(patch, job, edge);
-      if (Distance(samples.front(), samples.back()) < 1e-9 &&
-          Distance(samples.front(), samples[samples.size() / 2]) < 1e-9) {
-        continue;  // a pole: the device leaves it out anyway
-      }
-      const auto key = edge_key(samples);
-      bool shared = false;
-      for (auto [it, end] = drawn_edges.equal_range(key); it != end && !shared; ++it) {
-        shared = SameCurve(it->second, samples);
-      }
-      if (shared) {
-        body.skip_lines = static_cast<std::uint8_t>(body.skip_lines | bits[edge]);
-        ++job.shared_edges_skipped;
-      } else {
-        drawn_edges.emplace(key, samples);
-      }
-    }
-    job.commands.push_back(command);
-    job.labels.push_back("patch " + std::to_string(best) + " (" + patch.origin + ")");
-    job.patches.push_back(StreamedPatch{best, t.lines_s, t.lines_t});
+  // The patches, nearest neighbour first from the origin; the device fixes
+  // the order of the lines inside a patch, so a patch is never reversed.
+  std::vector<std::array<PlanPoint, 2>> ends;
+  ends.reserve(set.patches.size());
+  for (const Patch& patch : set.patches) ends.push_back(Ends(patch, job, t.lines_s, t.lines_t));
+  DrawnCurves drawn_edges;
+  for (const Visit& visit : OrderNearestNeighbour(ends, false, PlanMetric::kSpace)) {
+    const Patch& patch = set.patches[visit.index];
+    job.commands.push_back(PatchCommandFor(patch, t, machine, &job, &drawn_edges));
+    job.labels.push_back("patch " + std::to_string(visit.index) + " (" + patch.origin + ")");
+    job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
   }
   AddCurves(set, t, machine, &job);
   return job;

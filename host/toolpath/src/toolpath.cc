@@ -5,13 +5,13 @@
 #include <cmath>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/constructions.h"
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/fixed_engine.h"
-#include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/text.h"
 
 namespace fdsurf::host {
 namespace {
@@ -24,17 +24,6 @@ std::array<double, 3> Cross(const std::array<double, 3>& a, const std::array<dou
 
 double Dot(const std::array<double, 3>& a, const Point3& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-View ViewFromAngles(const std::string& name, double azimuth_deg, double elevation_deg) {
-  const double az = azimuth_deg * kPi / 180;
-  const double el = elevation_deg * kPi / 180;
-  View v;
-  v.name = name;
-  v.depth = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
-  v.right = {-std::sin(az), std::cos(az), 0};
-  v.up = Cross(v.depth, v.right);
-  return v;
 }
 
 // The range of a·u³ + b·u² + c·u + d over [0, 1]: the ends and the roots of
@@ -148,13 +137,6 @@ bool IsCurvePoint(Basis basis, int k) {
   }
 }
 
-std::string Number(double v) {
-  std::ostringstream out;
-  out.precision(6);
-  out << v;
-  return out.str();
-}
-
 constexpr double kInverseSqrt[4] = {0, 1.0, 0.70710678118654752, 0.57735026918962576};
 
 // Why the engine refused a line, for the person who asked for it.
@@ -165,7 +147,7 @@ constexpr double kInverseSqrt[4] = {0, 1.0, 0.70710678118654752, 0.5773502691896
       why += options.mode == StepMode::kStepExact
                  ? "a step-exact path would need steps below 2^-30 of the curve or more than 128 "
                    "accumulator bits; use a coarser quantum"
-                 : "the tolerance needs steps below 2^-30 of the curve; use a larger --tolerance";
+                 : "the tolerance needs steps below 2^-30 of the curve; use a larger tolerance";
       break;
     case Status::kGeometryOutOfRange:
       why += "the curve could reach ±2^31 quanta; use a coarser quantum";
@@ -282,50 +264,28 @@ void DrawCurve(const Curve& curve, std::size_t index, const OutputMap& map,
   if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
 }
 
-double PlaneDistance(const std::array<std::int64_t, 3>& a, const std::array<std::int64_t, 3>& b) {
-  return std::hypot(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]));
-}
-
-double StrokeLength(const Stroke& s) {
-  double length = 0;
-  for (std::size_t k = 1; k < s.points.size(); ++k)
-    length += PlaneDistance(s.points[k - 1], s.points[k]);
-  return length;
-}
-
-double Travel(const std::vector<Stroke>& strokes) {
-  std::array<std::int64_t, 3> pen{0, 0, 0};
-  double travel = 0;
-  for (const Stroke& s : strokes) {
-    travel += PlaneDistance(pen, s.points.front());
-    pen = s.points.back();
+// One value in output units as engine geometry; EngineError naming `origin`
+// beyond the engine's range.
+GeometryFixed OutputGeometry(double value, const Quantum& quantum, const std::string& origin) {
+  const std::optional<GeometryFixed> geometry = ToGeometry(value, quantum);
+  if (!geometry) {
+    throw EngineError(origin + ": in output space a control value reaches " + FormatNumber(value) +
+                      " units, beyond ±2^31 quanta of " + quantum.Format(1) +
+                      "; use a coarser quantum or a smaller page");
   }
-  return travel;
-}
-
-void Reverse(Stroke* s) {
-  std::reverse(s->points.begin(), s->points.end());
-  std::reverse(s->params.begin(), s->params.end());
+  return *geometry;
 }
 
 }  // namespace
 
 void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quantum, int dims,
                    PatchGeometry1* geometry) {
-  const double limit = std::ldexp(1.0, 31);
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
       const auto out =
           IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
       for (int c = 0; c < dims; ++c) {
-        const double q = quantum.ToQuanta(out[c]);
-        if (!(std::fabs(q) < limit)) {
-          throw EngineError(patch.origin + ": in output space a control value reaches " +
-                            Number(out[c]) + " " + "units, beyond ±2^31 quanta of " +
-                            quantum.Format(1) + "; use a coarser quantum or a smaller --fit");
-        }
-        geometry[c].g[i][j] = GeometryFixed::FromRaw(
-            static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
+        geometry[c].g[i][j] = OutputGeometry(out[c], quantum, patch.origin);
       }
     }
   }
@@ -333,62 +293,46 @@ void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quan
 
 void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
                    CurveGeometry1* geometry) {
-  const double limit = std::ldexp(1.0, 31);
   for (int k = 0; k < 4; ++k) {
     const auto out =
         IsCurvePoint(curve.basis, k) ? map.Apply(curve.g[k]) : map.ApplyLinear(curve.g[k]);
-    for (int c = 0; c < dims; ++c) {
-      const double q = quantum.ToQuanta(out[c]);
-      if (!(std::fabs(q) < limit)) {
-        throw EngineError(curve.origin + ": in output space a control value reaches " +
-                          Number(out[c]) + " units, beyond ±2^31 quanta of " + quantum.Format(1) +
-                          "; use a coarser quantum or a smaller --fit");
-      }
-      geometry[c].g[k] = GeometryFixed::FromRaw(
-          static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits))));
-    }
+    for (int c = 0; c < dims; ++c) geometry[c].g[k] = OutputGeometry(out[c], quantum, curve.origin);
   }
 }
 
-View ParseView(const std::string& text, const std::string& what) {
+std::optional<View> NamedView(const std::string& name) {
   View v;
-  v.name = text;
-  if (text == "top") {
+  v.name = name;
+  if (name == "top") {
     v.right = {1, 0, 0};
     v.up = {0, 1, 0};
-  } else if (text == "front") {
+  } else if (name == "front") {
     v.right = {1, 0, 0};
     v.up = {0, 0, 1};
-  } else if (text == "side") {
+  } else if (name == "side") {
     v.right = {0, 1, 0};
     v.up = {0, 0, 1};
-  } else if (text == "iso") {
-    return ViewFromAngles(text, -45, std::atan(1 / std::sqrt(2.0)) * 180 / kPi);
+  } else if (name == "iso") {
+    return ViewFromAngles(name, -45, std::atan(1 / std::sqrt(2.0)) * 180 / kPi);
   } else {
-    const std::size_t comma = text.find(',');
-    double az = 0, el = 0;
-    std::size_t used_az = 0, used_el = 0;
-    bool ok = comma != std::string::npos;
-    try {
-      if (ok) {
-        az = std::stod(text.substr(0, comma), &used_az);
-        el = std::stod(text.substr(comma + 1), &used_el);
-      }
-    } catch (const std::exception&) {
-      ok = false;
-    }
-    ok = ok && used_az == comma && used_el == text.size() - comma - 1 && std::isfinite(az) &&
-         std::isfinite(el);
-    if (!ok) {
-      throw InputError(what + ": '" + text +
-                       "' is not a view: use top, front, side, iso or AZ,EL in degrees");
-    }
-    if (el < -90 || el > 90) {
-      throw InputError(what + ": elevation " + Number(el) + " is outside -90..90 degrees");
-    }
-    return ViewFromAngles(text, az, el);
+    return std::nullopt;
   }
   v.depth = Cross(v.right, v.up);
+  return v;
+}
+
+View ViewFromAngles(const std::string& name, double azimuth_deg, double elevation_deg) {
+  if (!(elevation_deg >= -90 && elevation_deg <= 90) || !std::isfinite(azimuth_deg)) {
+    throw OptionError("view", "",
+                      "elevation " + FormatNumber(elevation_deg) + " is outside -90..90 degrees");
+  }
+  const double az = azimuth_deg * kPi / 180;
+  const double el = elevation_deg * kPi / 180;
+  View v;
+  v.name = name;
+  v.depth = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
+  v.right = {-std::sin(az), std::cos(az), 0};
+  v.up = Cross(v.depth, v.right);
   return v;
 }
 
@@ -405,20 +349,21 @@ std::array<double, 3> OutputMap::Apply(const Point3& p) const {
 Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units) {
   if (options.lines_s == 1 || options.lines_t == 1 || options.lines_s < 0 || options.lines_t < 0 ||
       options.lines_s > kMaxPatchSteps + 1 || options.lines_t > kMaxPatchSteps + 1) {
-    throw InputError("--lines: each count must be 0 (family left out) or 2.." +
-                     std::to_string(kMaxPatchSteps + 1));
+    throw OptionError(
+        "lines", "",
+        "each count must be 0 (family left out) or 2.." + std::to_string(kMaxPatchSteps + 1));
   }
   if (options.lines_s == 0 && options.lines_t == 0) {
-    throw InputError("--lines: both families are left out; nothing to draw");
+    throw OptionError("lines", "", "both families are left out; nothing to draw");
   }
   const double needed =
       std::sqrt(static_cast<double>(options.dims)) * (0.5 + 1.0 / 1024) * options.quantum.value();
   if (!(options.tolerance > needed * 1.003)) {
-    throw InputError("--tolerance " + Number(options.tolerance) + " " + units +
-                     " is too small: with points rounded to the quantum " +
-                     options.quantum.Format(1) + " " + units + " it must exceed " +
-                     Number(needed * 1.003) + " " + units + " (√" + std::to_string(options.dims) +
-                     "·0.501 quanta)");
+    throw OptionError("tolerance", FormatNumber(options.tolerance) + " " + units,
+                      "is too small: with points rounded to the quantum " +
+                          options.quantum.Format(1) + " " + units + " it must exceed " +
+                          FormatNumber(needed * 1.003) + " " + units + " (√" +
+                          std::to_string(options.dims) + "·0.501 quanta)");
   }
   if (set.patches.empty() && set.curves.empty()) {
     throw InputError("the file has no patches or curves to draw");
@@ -438,11 +383,13 @@ Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std
     const double w = (*options.fit)[0] - 2 * options.margin;
     const double h = (*options.fit)[1] - 2 * options.margin;
     if (!(w > 0 && h > 0)) {
-      throw InputError("--fit: the page " + Number((*options.fit)[0]) + "x" +
-                       Number((*options.fit)[1]) + " leaves no room inside the margin of " +
-                       Number(options.margin));
+      throw OptionError("fit", "",
+                        "the page " + FormatNumber((*options.fit)[0]) + "x" +
+                            FormatNumber((*options.fit)[1]) +
+                            " leaves no room inside the margin of " + FormatNumber(options.margin));
     }
-    if (bw <= 0 && bh <= 0) throw InputError("--fit: the drawing is a single point in this view");
+    if (bw <= 0 && bh <= 0)
+      throw OptionError("fit", "", "the drawing is a single point in this view");
     scale = std::min(bw > 0 ? w / bw : HUGE_VAL, bh > 0 ? h / bh : HUGE_VAL);
     path.width = (*options.fit)[0];
     path.height = (*options.fit)[1];
@@ -497,130 +444,6 @@ std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path
   auto out = path.map.Apply(p);
   if (path.dims == 2) out[2] = 0;
   return out;
-}
-
-PlanReport PlanStrokes(Toolpath* path) {
-  PlanReport report;
-  std::vector<Stroke>& strokes = path->strokes;
-  const double q = path->quantum.value();
-  report.strokes_before = strokes.size();
-  for (const Stroke& s : strokes) report.pen_down_before += StrokeLength(s) * q;
-  report.pen_up_before = Travel(strokes) * q;
-
-  // 1. Strokes drawn twice: patches that share an edge both draw it.
-  std::set<std::vector<std::array<std::int64_t, 3>>> seen;
-  std::vector<Stroke> unique;
-  for (Stroke& s : strokes) {
-    auto reversed = s.points;
-    std::reverse(reversed.begin(), reversed.end());
-    const auto& key = std::min(s.points, reversed);
-    if (!seen.insert(key).second) {
-      ++report.duplicates_removed;
-      continue;
-    }
-    unique.push_back(std::move(s));
-  }
-
-  // 2. Join strokes that meet end to end into one pen-down stroke.
-  std::multimap<std::array<std::int64_t, 3>, std::size_t> ends;
-  for (std::size_t i = 0; i < unique.size(); ++i) {
-    ends.emplace(unique[i].points.front(), i);
-    ends.emplace(unique[i].points.back(), i);
-  }
-  std::vector<bool> used(unique.size(), false);
-  const auto take_at = [&](const std::array<std::int64_t, 3>& point) -> std::ptrdiff_t {
-    auto [lo, hi] = ends.equal_range(point);
-    for (auto it = lo; it != hi; ++it) {
-      if (!used[it->second]) return static_cast<std::ptrdiff_t>(it->second);
-    }
-    return -1;
-  };
-  std::vector<Stroke> joined;
-  for (std::size_t i = 0; i < unique.size(); ++i) {
-    if (used[i]) continue;
-    used[i] = true;
-    Stroke chain = std::move(unique[i]);
-    for (int side = 0; side < 2; ++side) {
-      for (;;) {
-        const std::ptrdiff_t next = take_at(chain.points.back());
-        if (next < 0) break;
-        used[next] = true;
-        Stroke& other = unique[next];
-        if (other.points.front() != chain.points.back()) Reverse(&other);
-        chain.points.insert(chain.points.end(), other.points.begin() + 1, other.points.end());
-      }
-      Reverse(&chain);  // then extend the other end
-    }
-    chain.params.clear();  // a joined stroke spans several curves
-    joined.push_back(std::move(chain));
-  }
-
-  // 3. Order: nearest neighbour from the origin, reversing where it helps.
-  std::vector<Stroke> ordered;
-  std::vector<bool> placed(joined.size(), false);
-  std::array<std::int64_t, 3> pen{0, 0, 0};
-  for (std::size_t n = 0; n < joined.size(); ++n) {
-    double best = HUGE_VAL;
-    std::size_t best_index = 0;
-    bool best_reversed = false;
-    for (std::size_t i = 0; i < joined.size(); ++i) {
-      if (placed[i]) continue;
-      const double to_front = PlaneDistance(pen, joined[i].points.front());
-      const double to_back = PlaneDistance(pen, joined[i].points.back());
-      if (to_front < best) {
-        best = to_front;
-        best_index = i;
-        best_reversed = false;
-      }
-      if (to_back < best) {
-        best = to_back;
-        best_index = i;
-        best_reversed = true;
-      }
-    }
-    placed[best_index] = true;
-    if (best_reversed) Reverse(&joined[best_index]);
-    pen = joined[best_index].points.back();
-    ordered.push_back(std::move(joined[best_index]));
-  }
-
-  // 4. 2-opt: reversing the run i..j (and each stroke in it) replaces the
-  // links exit(i-1)→entry(i) and exit(j)→entry(j+1) by exit(i-1)→exit(j) and
-  // entry(i)→entry(j+1). A window keeps large drawings fast.
-  const std::size_t n = ordered.size();
-  const auto exit_of = [&](std::size_t k) {
-    return k == 0 ? std::array<std::int64_t, 3>{0, 0, 0} : ordered[k - 1].points.back();
-  };
-  constexpr std::size_t kWindow = 300;
-  for (int pass = 0; pass < 30; ++pass) {
-    bool improved = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto before = exit_of(i);
-      for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
-        const double old_links =
-            PlaneDistance(before, ordered[i].points.front()) +
-            (j + 1 < n ? PlaneDistance(ordered[j].points.back(), ordered[j + 1].points.front())
-                       : 0);
-        const double new_links =
-            PlaneDistance(before, ordered[j].points.back()) +
-            (j + 1 < n ? PlaneDistance(ordered[i].points.front(), ordered[j + 1].points.front())
-                       : 0);
-        if (new_links < old_links - 1e-9) {
-          std::reverse(ordered.begin() + static_cast<std::ptrdiff_t>(i),
-                       ordered.begin() + static_cast<std::ptrdiff_t>(j) + 1);
-          for (std::size_t k = i; k <= j; ++k) Reverse(&ordered[k]);
-          improved = true;
-        }
-      }
-    }
-    if (!improved) break;
-  }
-
-  strokes = std::move(ordered);
-  report.strokes_after = strokes.size();
-  for (const Stroke& s : strokes) report.pen_down_after += StrokeLength(s) * q;
-  report.pen_up_after = Travel(strokes) * q;
-  return report;
 }
 
 }  // namespace fdsurf::host

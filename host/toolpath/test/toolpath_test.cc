@@ -8,14 +8,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <set>
 
 #include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/plan.h"
 #include "fdsurf/host/toolpath.h"
 
 namespace fdsurf::host {
 namespace {
+
+// A view by name or as "AZ,EL" in degrees (the tool's --view, parsed simply).
+View ViewNamed(const std::string& text) {
+  if (const std::optional<View> named = NamedView(text)) return *named;
+  double az = 0;
+  double el = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf", &az, &el) != 2) throw InputError(text);
+  return ViewFromAngles(text, az, el);
+}
 
 using Vec = std::array<double, 3>;
 
@@ -84,7 +95,7 @@ PatchSet RandomPatches(std::mt19937_64& rng) {
 
 ToolpathOptions Options(const std::string& view, double tolerance, int dims, StepMode mode) {
   ToolpathOptions o;
-  o.view = ParseView(view);
+  o.view = ViewNamed(view);
   o.tolerance = tolerance;
   o.dims = dims;
   o.mode = mode;
@@ -242,7 +253,7 @@ TEST(Toolpath, PlanningKeepsEverySegmentAndCutsTravel) {
     return out;
   };
   const auto before = segments(path);
-  const PlanReport report = PlanStrokes(&path);
+  const PlanReport report = PlanStrokes(set, &path);
   EXPECT_EQ(segments(path), before);
   EXPECT_GT(report.duplicates_removed, 0u);  // the teapot's patches share edges
   EXPECT_LT(report.strokes_after, report.strokes_before);
@@ -251,12 +262,12 @@ TEST(Toolpath, PlanningKeepsEverySegmentAndCutsTravel) {
 }
 
 TEST(Toolpath, ViewsAreRotations) {
-  const auto top = ParseView("top");
+  const auto top = ViewNamed("top");
   EXPECT_EQ(top.right, (std::array<double, 3>{1, 0, 0}));
   EXPECT_EQ(top.up, (std::array<double, 3>{0, 1, 0}));
   EXPECT_EQ(top.depth, (std::array<double, 3>{0, 0, 1}));
   for (const char* name : {"iso", "30,45", "-120,-10", "0,90", "front", "side"}) {
-    const View v = ParseView(name);
+    const View v = ViewNamed(name);
     const std::array<double, 3>* rows[3] = {&v.right, &v.up, &v.depth};
     for (int a = 0; a < 3; ++a) {
       for (int b = 0; b < 3; ++b) {
@@ -267,11 +278,11 @@ TEST(Toolpath, ViewsAreRotations) {
     }
   }
   // front: x to the right, z up; side: y to the right, z up.
-  EXPECT_EQ(ParseView("front").up, (std::array<double, 3>{0, 0, 1}));
-  EXPECT_EQ(ParseView("side").right, (std::array<double, 3>{0, 1, 0}));
-  EXPECT_THROW(ParseView("diagonal"), InputError);
-  EXPECT_THROW(ParseView("10,95"), InputError);
-  EXPECT_THROW(ParseView("10,"), InputError);
+  EXPECT_EQ(ViewNamed("front").up, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ(ViewNamed("side").right, (std::array<double, 3>{0, 1, 0}));
+  EXPECT_FALSE(NamedView("diagonal"));
+  EXPECT_THROW(ViewFromAngles("10,95", 10, 95), OptionError);
+  EXPECT_THROW(ViewFromAngles("10,nan", 10, std::nan("")), OptionError);
 }
 
 TEST(Toolpath, RefusesWhatItCannotDraw) {

@@ -13,16 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
-
-/// Bad construction input (mismatched corners, too few curves, non-increasing
-/// parameters, ...). The message does not name the file.
-class ConstructionError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 // ---- Polynomials ------------------------------------------------------------
 

@@ -5,20 +5,14 @@
 #pragma once
 
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 
 #include "fdsurf/forward_difference.h"
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/quantum.h"
 
 namespace fdsurf::host {
-
-/// The engine refused a patch; the message says which and why.
-class EngineError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Converts `patch` into quanta with kGeometryFracBits guard bits and prepares
 /// it for a steps_s × steps_t grid. Throws EngineError (naming patch.origin)

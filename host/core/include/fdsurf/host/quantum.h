@@ -4,7 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+
+#include "fdsurf/fixed.h"
 
 namespace fdsurf::host {
 
@@ -12,7 +15,7 @@ class Quantum {
  public:
   /// Parses "0.001", "0.025", "1", "2.5". At most 9 significant digits and 9
   /// decimals; throws InputError naming `what` otherwise.
-  static Quantum Parse(const std::string& text, const std::string& what = "--quantum");
+  static Quantum Parse(const std::string& text, const std::string& what = "quantum");
 
   /// Q = mantissa · 10^-decimals.
   std::int64_t mantissa() const { return mantissa_; }
@@ -30,5 +33,12 @@ class Quantum {
   std::int64_t mantissa_ = 1;
   int decimals_ = 3;
 };
+
+/// `value` (in the units Q is given in) as the engine's geometry: value / Q
+/// rounded to the nearest 2^-16 quantum. The one conversion from doubles to
+/// fixed-point geometry on the host; nullopt when `value` is not finite or
+/// lies outside the engine's range (GeometryFixed, |value / Q| < 2^31
+/// quanta), so that the caller can name the value in its error.
+std::optional<GeometryFixed> ToGeometry(double value, const Quantum& quantum);
 
 }  // namespace fdsurf::host

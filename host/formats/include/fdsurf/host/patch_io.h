@@ -2,18 +2,12 @@
 // Reading patch files: BPT text and fdsurf JSON (docs/formats.md).
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
-
-/// Bad input: the message names the file and the place ("f.bpt:12: ...").
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Reads a BPT or JSON patch file; the format is taken from the extension
 /// (.bpt, .json) or, failing that, from the first non-blank character.

@@ -59,12 +59,13 @@ struct StreamJob {
 };
 
 /// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
-/// tolerance, dims; the quantum is replaced by machine.step). Orders the
-/// patches by nearest neighbour so that travel between them stays short, and
-/// leaves out edge lines that an earlier patch draws already (patches of a
-/// surface share their edges: the teapot's 32 patches share 52).
-/// Throws InputError (options, travel too small for the page) and
-/// EngineError (a patch out of range).
+/// tolerance, dims; the quantum is replaced by machine.step). The plan
+/// (plan.h) orders the patches by nearest neighbour so that travel between
+/// them stays short, and leaves out edge lines that an earlier patch draws
+/// already (patches of a surface share their edges: the teapot's 32 patches
+/// share 52). Throws OptionError ("lines", "tolerance", "fit", "travel X",
+/// "travel Y", "travel Z", "speed", "accel", "pen delay"), InputError (a
+/// file with nothing to draw) and EngineError (a patch out of range).
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
                          const MachineOptions& machine, const std::string& units);
 

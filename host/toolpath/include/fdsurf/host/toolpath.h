@@ -33,10 +33,16 @@ struct View {
   std::array<double, 3> depth{};
 };
 
-/// "top", "front", "side", "iso" or "AZ,EL" in degrees (azimuth from +x
-/// towards +y of the eye's direction, elevation above the xy plane).
-/// Throws InputError naming `what`.
-View ParseView(const std::string& text, const std::string& what = "--view");
+/// The named views: "top" (x right, y up), "front" (x right, z up), "side"
+/// (y right, z up) and "iso" (azimuth -45°, elevation atan(1/√2)); nullopt
+/// for another name.
+std::optional<View> NamedView(const std::string& name);
+
+/// The view from azimuth `azimuth_deg` (from +x towards +y, the direction of
+/// the eye) and elevation `elevation_deg` above the xy plane, in degrees.
+/// Throws OptionError ("view") for an elevation outside -90..90 or a value
+/// that is not finite.
+View ViewFromAngles(const std::string& name, double azimuth_deg, double elevation_deg);
 
 /// How curves are stepped.
 enum class StepMode {
@@ -112,8 +118,9 @@ struct Toolpath {
 using Progress = std::function<void(std::size_t, std::size_t, std::size_t)>;
 
 /// Checks the options and plans the page: the output map (view, scale to
-/// --fit, centring offset), width and height. No strokes. Throws InputError
-/// as BuildToolpath.
+/// the fit, centring offset), width and height. No strokes. Throws
+/// OptionError ("lines", "tolerance", "fit") for options that cannot be met
+/// and InputError for a file with nothing to draw.
 Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units);
 
 /// The patch's geometry in output space, in the engine's format: every
@@ -127,9 +134,10 @@ void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quan
 void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
                    CurveGeometry1* geometry);
 
-/// Draws every patch's isolines, then the file's curves. Throws InputError for options that cannot
-/// be met (tolerance below the quantum's reach, a drawing that does not fit)
-/// and EngineError (fixed_engine.h) when the engine refuses a curve.
+/// Draws every patch's isolines, then the file's curves. Throws as PlanPage
+/// for options that cannot be met (tolerance below the quantum's reach, a
+/// drawing that does not fit) and EngineError when the engine refuses a
+/// curve. `progress`, when set, is called after each patch.
 Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
                        const std::string& units, const Progress& progress = {});
 
@@ -137,21 +145,5 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
 /// through the same map), for checks.
 std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
                                        const Stroke& stroke, double param);
-
-struct PlanReport {
-  std::size_t strokes_before = 0;
-  std::size_t strokes_after = 0;
-  std::size_t duplicates_removed = 0;
-  double pen_down_before = 0;
-  double pen_down_after = 0;
-  double pen_up_before = 0;
-  double pen_up_after = 0;
-};
-
-/// Plans the pen's path: removes strokes drawn twice (shared patch edges),
-/// joins strokes that meet end to end, orders them by nearest neighbour from
-/// the origin with a 2-opt improvement pass, reversing strokes where it
-/// helps. Distances are in output units, in the drawing plane.
-PlanReport PlanStrokes(Toolpath* path);
 
 }  // namespace fdsurf::host

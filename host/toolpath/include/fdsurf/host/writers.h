@@ -4,19 +4,13 @@
 // so that a caller can produce everything before it writes anything.
 #pragma once
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/toolpath.h"
 
 namespace fdsurf::host {
-
-/// An output that could not be written; the message names the path.
-class OutputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// SVG 1.1: a page of width × height output units (mm or in), one <path> per
 /// stroke, y flipped so that up in the drawing is up on the page.

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: MIT
+// The pen's plan: what `fdsurf plot` and `fdsurf stream` both decide before
+// anything is drawn, in one place.
+//
+//  - Which curves are drawn already. Patches of a surface share their edges
+//    (the teapot's 32 patches share 52), and a curve is drawn once. Two
+//    curves are the same when nine samples of their exact (double) curves,
+//    in quanta, agree within 0.1 quanta forwards or backwards: DrawnCurves.
+//  - In what order the pieces are visited: nearest neighbour from the
+//    origin, entering a piece at its start (patches, whose drawing order the
+//    device fixes) or at either end (strokes): OrderNearestNeighbour.
+//
+// `plot` applies both to strokes and then joins strokes that meet and
+// improves the order by 2-opt (PlanStrokes); `stream` applies both to
+// patches, sending the edge lines drawn already as PATCH skip_lines
+// (stream.h).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/toolpath.h"
+
+namespace fdsurf::host {
+
+/// A point in output quanta (or motor steps), z = 0 in 2-D.
+using PlanPoint = std::array<double, 3>;
+
+/// Nine points of a curve at parameters 0, 1/8, ..., 1, in output quanta.
+using SampledCurve = std::array<PlanPoint, 9>;
+
+/// The exact isoline of `patch` through `map`, in units of `unit` (the
+/// quantum or the motor step): s fixed at `at` for s-lines, t for t-lines.
+SampledCurve SampleIsoline(const Patch& patch, const OutputMap& map, double unit, int dims,
+                           IsolineFamily family, double at);
+
+/// The same for a curve of the file.
+SampledCurve SampleCurve(const Curve& curve, const OutputMap& map, double unit, int dims);
+
+/// Whether the samples are all one point (a pole, like the teapot lid's top).
+bool IsPoint(const SampledCurve& samples);
+
+/// The curves drawn so far.
+class DrawnCurves {
+ public:
+  /// True when the same curve (within 0.1 units, either direction) was
+  /// added before; otherwise adds it and returns false.
+  bool CheckAndAdd(const SampledCurve& samples);
+
+ private:
+  /// Curves by their end points rounded to whole units, lower end first.
+  std::multimap<std::array<std::int64_t, 6>, SampledCurve> by_ends_;
+};
+
+/// How distances between pieces are measured.
+enum class PlanMetric {
+  /// In the drawing plane (x, y): a pen's travel.
+  kPlane,
+  /// In all three axes: a CNC's travel.
+  kSpace,
+};
+
+/// One piece of the order: its index, and whether it is entered at its end.
+struct Visit {
+  std::size_t index = 0;
+  bool reversed = false;
+};
+
+/// Greedy nearest neighbour from `start`: repeatedly the piece whose entry
+/// is nearest to where the last one left off (ends[i] = {start, end} of
+/// piece i; with `may_reverse` a piece may be entered at its end and left at
+/// its start). Ties go to the lower index, then to the forward direction.
+std::vector<Visit> OrderNearestNeighbour(const std::vector<std::array<PlanPoint, 2>>& ends,
+                                         bool may_reverse, PlanMetric metric,
+                                         const PlanPoint& start = {0, 0, 0});
+
+struct PlanReport {
+  std::size_t strokes_before = 0;
+  std::size_t strokes_after = 0;
+  /// Strokes that draw a curve drawn already by another (shared edges).
+  std::size_t duplicates_removed = 0;
+  /// Pen-down and pen-up (travel) lengths in output units, in the plane.
+  double pen_down_before = 0;
+  double pen_down_after = 0;
+  double pen_up_before = 0;
+  double pen_up_after = 0;
+};
+
+/// Plans the pen's path of a drawing of `set`: removes strokes that draw a
+/// curve drawn already (DrawnCurves), joins strokes that meet end to end,
+/// orders them by nearest neighbour from the origin (reversing where it
+/// helps) and improves the order by 2-opt. Distances are in the drawing
+/// plane. Joined strokes lose their params (they span several curves).
+PlanReport PlanStrokes(const PatchSet& set, Toolpath* path);
+
+}  // namespace fdsurf::host
