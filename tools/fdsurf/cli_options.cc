@@ -3,6 +3,8 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -15,6 +17,43 @@
 #include "fdsurf/host/errors.h"
 
 namespace fdsurf::host {
+
+Grid ParseGrid(const std::string& text) {
+  const auto fail = [&](const std::string& why) {
+    return InputError("--grid: '" + text + "' " + why);
+  };
+  const std::size_t x = text.find('x');
+  const auto parse = [&](std::string_view part) {
+    int value = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (part.empty() || ec != std::errc() || end != part.data() + part.size()) {
+      throw fail("is not N or NxM with whole numbers N, M");
+    }
+    if (value < 1 || value > kMaxPatchSteps) {
+      throw fail("is out of range: each dimension must be between 1 and " +
+                 std::to_string(kMaxPatchSteps));
+    }
+    return value;
+  };
+  const std::string_view all(text);
+  Grid grid;
+  grid.steps_s = parse(all.substr(0, x));
+  grid.steps_t = x == std::string::npos ? grid.steps_s : parse(all.substr(x + 1));
+  return grid;
+}
+
+void AddGridOptions(CLI::App* command, GridOptions* options) {
+  command->add_option("FILE", options->file, "patch file (.bpt or .json, see docs/formats.md)")
+      ->required();
+  command
+      ->add_option("--grid", options->grid,
+                   "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))
+      ->required();
+  command
+      ->add_option("--quantum", options->quantum,
+                   "output quantum Q in file units; positions are whole multiples of Q")
+      ->capture_default_str();
+}
 
 double ParsePositive(const std::string& text, const std::string& what, bool allow_zero) {
   double value = 0;

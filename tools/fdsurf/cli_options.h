@@ -9,7 +9,31 @@
 
 #include "fdsurf/host/toolpath.h"
 
+namespace CLI {
+class App;
+}
+
 namespace fdsurf::host {
+
+/// --grid: steps per patch along s and t.
+struct Grid {
+  int steps_s = 0;
+  int steps_t = 0;
+};
+
+/// "N" or "NxM", each 1..kMaxPatchSteps; InputError naming --grid otherwise.
+Grid ParseGrid(const std::string& text);
+
+/// The options of `sample` and `check`: a file evaluated on a grid.
+struct GridOptions {
+  std::string file;
+  std::string grid;
+  std::string engine = "fixed";
+  std::string quantum = "0.001";
+};
+
+/// Adds FILE, --grid and --quantum (the options `sample` and `check` share).
+void AddGridOptions(CLI::App* command, GridOptions* options);
 
 /// A number > 0 (or ≥ 0 with allow_zero); InputError naming `what` otherwise.
 double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false);

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// The commands of the fdsurf tool, one file each: sample_command.cc,
+// check_command.cc, plot_command.cc (plot and render), stream_command.cc,
+// construct_commands.cc (joins). Each Run* returns the exit code: 0 done,
+// 1 a bound broken, 2 bad input; they throw InputError, OptionError,
+// OutputError and EngineError, which main.cc reports.
+#pragma once
+
+#include <string>
+
+#include "cli_options.h"
+#include "fdsurf/host/writers.h"
+
+namespace CLI {
+class App;
+}
+
+namespace fdsurf::host {
+
+/// `sample`: prints patch,i,j,x,y,z for every grid point (and the curves).
+int RunSample(const GridOptions& options);
+
+/// `check`: per patch, the accumulator, the exactness and the largest error
+/// in quanta; 1 when a point is outside 0.51 quanta.
+int RunCheck(const GridOptions& options);
+
+struct PlotOptions {
+  std::string file;
+  std::string format;
+  std::string output = "-";
+  std::string png;
+  int png_width = 1600;
+  std::string tolerance;
+  std::string lines = "8";
+  std::string view = "iso";
+  std::string units = "mm";
+  std::string fit;
+  std::string margin;
+  std::string quantum;
+  std::string mode = "adaptive";
+  int dims = 2;
+  bool plan = true;
+  bool quiet = false;
+  GcodeOptions gcode;
+};
+
+/// Adds the options of `plot` (or, with `render_only`, of `render`).
+void AddPlotOptions(CLI::App* command, PlotOptions* options, bool render_only);
+
+/// `plot` and `render`: draws the isolines and writes them.
+int RunPlot(const PlotOptions& options, bool render_only);
+
+}  // namespace fdsurf::host

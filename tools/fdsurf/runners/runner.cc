@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: MIT
+#include "runner.h"
+
+#include <cstdio>
+
+#include "fdsurf/host/errors.h"
+#include "fdsurf/protocol/codec.h"
+
+namespace fdsurf::host {
+
+// Status queries four times a second: enough for the progress line and for
+// noticing the end, few enough to leave the link to the commands.
+HostLinkOptions LinkOptions() {
+  HostLinkOptions options;
+  options.status_interval_us = 250'000;
+  return options;
+}
+
+void Enqueue(const StreamJob& job, HostLink* link) {
+  for (std::size_t k = 0; k < job.commands.size(); ++k) {
+    const protocol::DecodeResult result = link->Enqueue(job.commands[k], job.labels[k]);
+    if (!result.ok()) {
+      throw EngineError(job.labels[k] + ": cannot be sent: " + protocol::ErrorName(result.code) +
+                        " (field " + std::to_string(result.field) + ", docs/protocol.md)");
+    }
+  }
+}
+
+// A device moves at most one step per axis per tick.
+void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const StreamOptions& o) {
+  if (job.config.max_rate > tick_hz) {
+    throw InputError("--speed " + std::to_string(static_cast<int>(o.speed)) + " " + o.units +
+                     "/s is " + std::to_string(job.config.max_rate) +
+                     " steps/s, more than the device's " + std::to_string(tick_hz) +
+                     " ticks/s (one step per tick at most): lower --speed or raise --tick-hz");
+  }
+}
+
+void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64_t frames,
+                      double machine_seconds, bool force) {
+  if (!enabled_) return;
+  const auto now = Clock::now();
+  if (!force && shown_ && now - last_ < std::chrono::milliseconds(100)) return;
+  last_ = now;
+  const double wall = std::chrono::duration<double>(now - start_).count();
+  const int percent = total == 0 ? 100 : static_cast<int>(executed * 100 / total);
+  constexpr int kWidth = 24;
+  std::string bar(kWidth, '.');
+  for (int i = 0; i < percent * kWidth / 100; ++i) bar[static_cast<std::size_t>(i)] = '#';
+  // The simulator reports its machine time: show how much faster than
+  // real time it runs; a real device runs in real time, so show the rate.
+  char rate[64];
+  if (machine_seconds > 0) {
+    std::snprintf(rate, sizeof rate, "%.1f s machine time, %.0fx real time", machine_seconds,
+                  wall > 0 ? machine_seconds / wall : 0.0);
+  } else {
+    std::snprintf(rate, sizeof rate, "%.2f commands/s",
+                  wall > 0 ? static_cast<double>(executed) / wall : 0.0);
+  }
+  std::fprintf(
+      stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
+      bar.c_str(), percent, static_cast<unsigned long long>(executed),
+      static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate);
+  shown_ = true;
+}
+
+void ProgressLine::Finish() {
+  if (shown_) std::fputc('\n', stderr);
+  shown_ = false;
+}
+
+}  // namespace fdsurf::host

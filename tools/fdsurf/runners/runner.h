@@ -1,0 +1,77 @@
+// SPDX-License-Identifier: MIT
+// The device runners of `fdsurf stream`: each takes a planned job
+// (stream.h) to one kind of device through the host end of the link
+// (HostLink) and reports what happened.
+//
+//   sim   the simulated plotter (sim/): the firmware in virtual time, with
+//         the drawing and the motion checked afterwards (sim_runner.cc)
+//   usb   a controller on a vendor-specific bulk interface, through libusb
+//         (usb_runner.cc)
+//   gpio  this host is the controller: the firmware's Device runs here in
+//         real time on GPIO lines, through libgpiod (gpio_runner.cc)
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "../stream_command.h"
+#include "fdsurf/host/errors.h"
+#include "fdsurf/host/link.h"
+#include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/stream.h"
+#include "fdsurf/host/toolpath.h"
+
+namespace fdsurf::host {
+
+/// A device-side failure or a link that could not be recovered (exit 3).
+class DeviceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The link's settings for every runner.
+HostLinkOptions LinkOptions();
+
+/// Queues every command of the job on the link; EngineError for a command
+/// the codec refuses (naming its label and field).
+void Enqueue(const StreamJob& job, HostLink* link);
+
+/// A device moves at most one step per axis per tick: InputError naming
+/// --speed and --tick-hz when the job's speed needs more.
+void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const StreamOptions& o);
+
+/// The progress line on stderr: a bar, commands executed, frames sent, and
+/// the rate (machine time over wall time for the simulator).
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
+  ~ProgressLine() { Finish(); }
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
+
+  /// Redraws at most 10 times a second (and always when `force`).
+  /// `machine_seconds` > 0 for a simulated device.
+  void Show(std::uint64_t executed, std::uint64_t total, std::uint64_t frames,
+            double machine_seconds, bool force = false);
+  /// Ends the line, if one was drawn.
+  void Finish();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  bool shown_ = false;
+  Clock::time_point start_;
+  Clock::time_point last_;
+};
+
+/// Each runner returns the command's exit code (stream_command.h) and
+/// throws DeviceError when the device fails or the link is lost, InputError
+/// for a bad --device.
+int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
+                 const ToolpathOptions& drawing, const std::string& units);
+int RunUsb(const StreamOptions& o, const StreamJob& job);
+int RunGpio(const StreamOptions& o, const StreamJob& job);
+
+}  // namespace fdsurf::host

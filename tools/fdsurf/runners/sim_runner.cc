@@ -1,0 +1,211 @@
+// SPDX-License-Identifier: MIT
+// The simulated plotter as the device: the job runs in virtual time, then
+// the drawing is compared with the exact curves and the recorded steps with
+// the machine's limits.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "../cli_options.h"
+#include "fdsurf/host/plan.h"
+#include "fdsurf/host/writers.h"
+#include "fdsurf/protocol/codec.h"
+#include "fdsurf/sim/checks.h"
+#include "fdsurf/sim/plotter.h"
+#include "runner.h"
+
+namespace fdsurf::host {
+namespace {
+
+// The drawn paths as a toolpath on the job's page, for the writers. A point
+// between two unit moves in the same direction lies on the line through its
+// neighbours: leaving it out draws exactly the same path with far fewer
+// points (the teapot's SVG: 14.8 MB instead of 26; it stays the exact step path).
+Toolpath DrawnToolpath(const StreamJob& job, const std::vector<sim::DrawnPath>& paths) {
+  Toolpath drawn = job.page;
+  drawn.strokes.clear();
+  for (const sim::DrawnPath& path : paths) {
+    Stroke stroke;
+    const auto& p = path.points;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      const bool straight_through = k > 0 && k + 1 < p.size() &&
+                                    p[k][0] - p[k - 1][0] == p[k + 1][0] - p[k][0] &&
+                                    p[k][1] - p[k - 1][1] == p[k + 1][1] - p[k][1] &&
+                                    p[k][2] - p[k - 1][2] == p[k + 1][2] - p[k][2];
+      if (!straight_through) stroke.points.push_back(p[k]);
+    }
+    drawn.strokes.push_back(std::move(stroke));
+  }
+  return drawn;
+}
+
+// The same drawing as G-code line segments at the same tolerance: what a
+// host would send a G-code controller instead of patches.
+std::size_t GcodeBytes(const PatchSet& set, const ToolpathOptions& drawing,
+                       const std::string& units) {
+  ToolpathOptions t = drawing;
+  t.mode = StepMode::kAdaptive;
+  t.quantum = Quantum::Parse(units == "in" ? "0.0001" : "0.001");
+  Toolpath path = BuildToolpath(set, t, units);
+  PlanStrokes(set, &path);
+  return WriteGcode(path, GcodeOptions{}, {}).size();
+}
+
+std::size_t CommandBytes(const StreamJob& job) {
+  std::size_t bytes = 0;
+  std::vector<std::uint8_t> frame(protocol::kMaxEncodedFrameBytes);
+  for (const protocol::Command& command : job.commands) {
+    bytes += protocol::EncodeCommand(command, frame.data(), frame.size());
+  }
+  return bytes;
+}
+
+sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o) {
+  sim::PlotterOptions options;
+  options.axes = o.dims;
+  if (o.tick_hz != 0) options.tick_hz = o.tick_hz;
+  options.bytes_per_second = o.link_bytes_per_second;
+  options.to_device = sim::FaultRates::All(o.faults);
+  options.to_host = sim::FaultRates::All(o.faults);
+  options.fault_seed = o.seed;
+  return options;
+}
+
+// Streams the job to the plotter until every command ran (or the link gave
+// up), with the progress line.
+sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
+                               sim::SimulatedPlotter* plotter) {
+  HostLink link(LinkOptions());
+  Enqueue(job, &link);
+  ProgressLine progress(ShowProgress(o.quiet));
+  constexpr std::uint64_t kTimeLimitUs = 24ull * 3600 * 1'000'000;  // a day of machine time
+  const sim::RunResult run = plotter->Run(
+      link, kTimeLimitUs,
+      [&](const sim::RunProgress& p) {
+        progress.Show(p.executed, p.total, p.frames_sent, p.time_us * 1e-6);
+      },
+      250'000);
+  progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6, true);
+  progress.Finish();
+  return run;
+}
+
+// What the plotter drew, checked against the exact curves and the limits.
+struct CheckedDrawing {
+  std::vector<sim::DrawnPath> drawn;
+  sim::DrawingComparison comparison;
+  sim::MotionReport motion;
+  /// The deviation bound in steps: the tolerance, plus what the reference
+  /// polyline itself may be off the exact curve (0.005 steps).
+  double bound = 0;
+  bool within = false;
+  bool limits_kept = false;
+};
+
+CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet& set,
+                            const StreamJob& job, std::uint32_t tick_hz, int dims) {
+  CheckedDrawing checked;
+  checked.drawn = plotter.DrawnPaths();
+  std::vector<sim::ReferenceLine> reference;
+  for (auto& line : ReferenceLines(set, job)) {
+    reference.push_back(sim::ReferenceLine{std::move(line)});
+  }
+  checked.comparison = sim::CompareDrawing(checked.drawn, reference, dims);
+  sim::MotionLimitsSi limits;
+  limits.tick_hz = tick_hz;
+  limits.max_rate = job.config.max_rate;
+  limits.accel = job.config.accel;
+  limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
+  checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
+  checked.bound = job.tolerance_steps + 0.005;
+  checked.within = checked.comparison.max_deviation <= checked.bound &&
+                   checked.comparison.max_gap <= checked.bound;
+  checked.limits_kept = checked.motion.violations == 0;
+  return checked;
+}
+
+// SVG and PNG of what was drawn: every one complete before any is renamed
+// into place.
+void WriteDrawing(const StreamOptions& o, const StreamJob& job,
+                  const std::vector<sim::DrawnPath>& drawn) {
+  const Toolpath drawn_path = DrawnToolpath(job, drawn);
+  StagedOutputs outputs;
+  if (!o.svg.empty()) {
+    WriteFile(outputs.Stage(o.svg),
+              WriteSvg(drawn_path, o.file + " drawn by the simulated plotter"));
+  }
+  if (!o.png.empty()) RenderPng(drawn_path, o.png_width, outputs.Stage(o.png));
+  outputs.Commit();
+}
+
+void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
+                 const ToolpathOptions& drawing, const std::string& units,
+                 const sim::PlotterOptions& plotter_options, const sim::RunResult& run,
+                 const CheckedDrawing& checked) {
+  const double step = job.page.quantum.value();
+  const sim::DrawingComparison& comparison = checked.comparison;
+  const sim::MotionReport& motion = checked.motion;
+  std::size_t points = 0;
+  for (const sim::DrawnPath& p : checked.drawn) points += p.points.size();
+  const std::size_t command_bytes = CommandBytes(job);
+  const std::size_t gcode_bytes = GcodeBytes(set, drawing, units);
+  const std::string what =
+      std::to_string(job.patches.size()) + " patches" +
+      (job.curves.empty() ? std::string() : " and " + std::to_string(job.curves.size()) + " curves");
+  std::fprintf(stderr,
+               "%s: %s streamed to the simulated plotter (%u axes, %u Hz ticks); %zu shared edges "
+               "drawn once\n",
+               o.file.c_str(), what.c_str(), plotter_options.axes, plotter_options.tick_hz,
+               job.shared_edges_skipped);
+  std::fprintf(stderr,
+               "link: %llu frames sent (%llu commands, %llu resent), %llu bytes to the device, "
+               "%llu NAKs, %llu timeouts; all acknowledged after %.2f s\n",
+               static_cast<unsigned long long>(run.host.frames_sent),
+               static_cast<unsigned long long>(run.host.commands_sent),
+               static_cast<unsigned long long>(run.host.retransmitted),
+               static_cast<unsigned long long>(run.host.bytes_sent),
+               static_cast<unsigned long long>(run.host.naks),
+               static_cast<unsigned long long>(run.host.timeouts), run.acknowledged_us * 1e-6);
+  std::fprintf(stderr,
+               "wire: %zu bytes of command frames vs %zu bytes of G-code for the same drawing at "
+               "the same tolerance (%.1fx smaller)\n",
+               command_bytes, gcode_bytes,
+               static_cast<double>(gcode_bytes) / static_cast<double>(command_bytes));
+  std::fprintf(stderr,
+               "machine: %.1f s, %zu moves, %.0f %s of path (%zu pen-down strokes, %zu points), "
+               "top speed %.1f %s/s\n",
+               motion.duration_s, motion.moves, motion.path_length * step, units.c_str(),
+               checked.drawn.size(), points, motion.max_speed * step, units.c_str());
+  std::fprintf(stderr,
+               "drawing vs exact curves: max deviation %.3f steps (%.4f %s), max gap %.3f steps; "
+               "bound %.3f steps (--tolerance): %s\n",
+               comparison.max_deviation, comparison.max_deviation * step, units.c_str(),
+               comparison.max_gap, checked.bound, checked.within ? "within" : "BOUND VIOLATED");
+  const std::string limits =
+      checked.limits_kept ? std::string("kept")
+                          : std::to_string(motion.violations) +
+                                " violations, first: " + motion.first_violation;
+  std::fprintf(stderr, "motion limits (%.0f %s/s, %.0f %s/s², pen delay %d ms): %s\n", o.speed,
+               units.c_str(), o.accel, units.c_str(), o.pen_delay_ms, limits.c_str());
+  if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
+  if (!o.png.empty()) {
+    std::fprintf(stderr, "wrote %s (png, %d px wide)\n", o.png.c_str(), o.png_width);
+  }
+}
+
+}  // namespace
+
+int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
+                 const ToolpathOptions& drawing, const std::string& units) {
+  const sim::PlotterOptions plotter_options = PlotterOptionsFor(o);
+  CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
+  sim::SimulatedPlotter plotter(plotter_options);
+  const sim::RunResult run = StreamToPlotter(o, job, &plotter);
+  if (!run.finished) throw DeviceError("sim device: " + run.error);
+  const CheckedDrawing checked = CheckDrawing(plotter, set, job, plotter_options.tick_hz, o.dims);
+  WriteDrawing(o, job, checked.drawn);
+  if (!o.quiet) PrintReport(o, set, job, drawing, units, plotter_options, run, checked);
+  return checked.within && checked.limits_kept ? 0 : 1;
+}
+
+}  // namespace fdsurf::host
