@@ -146,7 +146,7 @@ protocol::Command PatchCommandFor(const Patch& patch, const ToolpathOptions& t,
 // The file's curves, in file order: CURVE commands with the pen down, and a
 // pen-up move only where a curve does not start where the one before ended
 // (so a chain is drawn in one stroke).
-void AddCurves(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
+void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
                StreamJob* job) {
   bool pen_down = false;
   bool placed = false;
@@ -242,7 +242,7 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     job.labels.push_back("patch " + std::to_string(visit.index) + " (" + patch.origin + ")");
     job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
   }
-  AddCurves(set, t, machine, &job);
+  AddCurveCommands(set, t, machine, &job);
   return job;
 }
 
