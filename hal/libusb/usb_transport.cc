@@ -305,6 +305,9 @@ IoStatus UsbTransport::Attach(bool reconnecting, std::string* error) {
   return status;
 }
 
+// The libusb calls stay here, in one sequence, so that their order (each
+// close before the error text is made) is plain to see: the hal tests' fakes
+// check it. The helpers above only read descriptors and word failures.
 UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
                                             const libusb_device_descriptor& descriptor,
                                             bool reconnecting, IoStatus* status,
