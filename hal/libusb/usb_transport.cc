@@ -75,6 +75,95 @@ unsigned RemainingMs(SteadyClock::time_point deadline) {
   return static_cast<unsigned>(std::clamp<int64_t>(left, 1, UINT_MAX));
 }
 
+// Why libusb_open failed, for the device node it names, as the status to
+// report and *text; permission trouble comes with the udev rule that fixes it.
+IoStatus DescribeOpenFailure(int rc, libusb_device* device, uint8_t bus,
+                             const libusb_device_descriptor& descriptor, std::string* text) {
+  char node[32];
+  std::snprintf(node, sizeof node, "/dev/bus/usb/%03u/%03u", bus,
+                libusb_get_device_address(device));
+  if (rc == LIBUSB_ERROR_ACCESS) {
+    char rule[128];
+    std::snprintf(rule, sizeof rule,
+                  R"(SUBSYSTEM=="usb", ATTR{idVendor}=="%04x", ATTR{idProduct}=="%04x", )"
+                  R"(MODE="0660", TAG+="uaccess")",
+                  descriptor.idVendor, descriptor.idProduct);
+    *text = std::string("permission denied opening ") + node + " (add a udev rule: " + rule +
+            "; see hal/README.md)";
+    return IoStatus::kPermissionDenied;
+  }
+  if (rc == LIBUSB_ERROR_NO_DEVICE) {
+    *text = std::string("vanished while opening ") + node;
+    return IoStatus::kNotFound;
+  }
+  *text = std::string("cannot open ") + node + ": " + libusb_error_name(rc);
+  return IoStatus::kIoError;
+}
+
+// The device's serial number string, empty when it has none or it cannot be
+// read.
+std::string ReadSerial(libusb_device_handle* handle, const libusb_device_descriptor& descriptor) {
+  std::string serial;
+  if (descriptor.iSerialNumber != 0) {
+    unsigned char text[256];
+    const int length =
+        libusb_get_string_descriptor_ascii(handle, descriptor.iSerialNumber, text, sizeof text);
+    if (length > 0) serial.assign(reinterpret_cast<const char*>(text), static_cast<size_t>(length));
+  }
+  return serial;
+}
+
+// Finds the vendor-specific interface `interface_number` (called `iface` in
+// messages) in the configuration and its first bulk OUT and IN endpoints.
+// Returns what is wrong, or an empty string when *out and *in are set.
+std::string FindBulkEndpoints(const libusb_config_descriptor& config, uint8_t interface_number,
+                              const std::string& iface, uint8_t* out, uint8_t* in) {
+  const libusb_interface_descriptor* interface = nullptr;
+  for (int i = 0; i < config.bNumInterfaces; ++i) {
+    const libusb_interface& candidate = config.interface[i];
+    if (candidate.num_altsetting > 0 &&
+        candidate.altsetting[0].bInterfaceNumber == interface_number) {
+      interface = &candidate.altsetting[0];
+    }
+  }
+  if (interface == nullptr) {
+    return "no " + iface + " (the device has " + std::to_string(config.bNumInterfaces) +
+           " interface" + (config.bNumInterfaces == 1 ? "" : "s") + ")";
+  }
+  if (interface->bInterfaceClass != LIBUSB_CLASS_VENDOR_SPEC) {
+    char klass[8];
+    std::snprintf(klass, sizeof klass, "0x%02x", interface->bInterfaceClass);
+    return iface + " is class " + klass + ", not vendor-specific (0xff)";
+  }
+  for (int e = 0; e < interface->bNumEndpoints; ++e) {
+    const libusb_endpoint_descriptor& endpoint = interface->endpoint[e];
+    if ((endpoint.bmAttributes & 0x03) != LIBUSB_ENDPOINT_TRANSFER_TYPE_BULK) continue;
+    uint8_t& slot = (endpoint.bEndpointAddress & LIBUSB_ENDPOINT_IN) != 0 ? *in : *out;
+    if (slot == 0) slot = endpoint.bEndpointAddress;
+  }
+  if (*out == 0 || *in == 0)
+    return iface + " has no bulk " + (*out == 0 ? "OUT" : "IN") + " endpoint";
+  return "";
+}
+
+// Why libusb_claim_interface failed, as the status to report and *text.
+IoStatus DescribeClaimFailure(int rc, const std::string& iface, std::string* text) {
+  switch (rc) {
+    case LIBUSB_ERROR_BUSY:
+      *text = iface + " busy (claimed by another program)";
+      return IoStatus::kBusy;
+    case LIBUSB_ERROR_ACCESS:
+      *text = "permission denied claiming " + iface;
+      return IoStatus::kPermissionDenied;
+    case LIBUSB_ERROR_NO_DEVICE:
+      *text = "vanished while claiming " + iface;
+      return IoStatus::kNotFound;
+    default:
+      *text = "cannot claim " + iface + ": " + libusb_error_name(rc);
+      return IoStatus::kIoError;
+  }
+}
+
 }  // namespace
 
 std::string UsbSelector::ToString() const {
@@ -216,6 +305,9 @@ IoStatus UsbTransport::Attach(bool reconnecting, std::string* error) {
   return status;
 }
 
+// The libusb calls stay here, in one sequence, so that their order (each
+// close before the error text is made) is plain to see: the hal tests' fakes
+// check it. The helpers above only read descriptors and word failures.
 UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
                                             const libusb_device_descriptor& descriptor,
                                             bool reconnecting, IoStatus* status,
@@ -241,37 +333,16 @@ UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
   libusb_device_handle* handle = nullptr;
   int rc = libusb_open(device, &handle);
   if (rc != 0) {
-    char node[32];
-    std::snprintf(node, sizeof node, "/dev/bus/usb/%03u/%03u", bus,
-                  libusb_get_device_address(device));
-    if (rc == LIBUSB_ERROR_ACCESS) {
-      char rule[128];
-      std::snprintf(rule, sizeof rule,
-                    R"(SUBSYSTEM=="usb", ATTR{idVendor}=="%04x", ATTR{idProduct}=="%04x", )"
-                    R"(MODE="0660", TAG+="uaccess")",
-                    descriptor.idVendor, descriptor.idProduct);
-      return fail(IoStatus::kPermissionDenied, std::string("permission denied opening ") + node +
-                                                   " (add a udev rule: " + rule +
-                                                   "; see hal/README.md)");
-    }
-    if (rc == LIBUSB_ERROR_NO_DEVICE) {
-      return fail(IoStatus::kNotFound, std::string("vanished while opening ") + node);
-    }
-    return fail(IoStatus::kIoError,
-                std::string("cannot open ") + node + ": " + libusb_error_name(rc));
+    std::string text;
+    const IoStatus failed = DescribeOpenFailure(rc, device, bus, descriptor, &text);
+    return fail(failed, std::move(text));
   }
   auto close_and = [&](Match match) {
     libusb_close(handle);
     return match;
   };
 
-  std::string serial;
-  if (descriptor.iSerialNumber != 0) {
-    unsigned char text[256];
-    const int length =
-        libusb_get_string_descriptor_ascii(handle, descriptor.iSerialNumber, text, sizeof text);
-    if (length > 0) serial.assign(reinterpret_cast<const char*>(text), static_cast<size_t>(length));
-  }
+  const std::string serial = ReadSerial(handle, descriptor);
   if (reconnecting && !serial_.empty() && serial != serial_) return close_and(Match::kSkipped);
 
   libusb_config_descriptor* config = nullptr;
@@ -281,36 +352,11 @@ UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
     return fail(IoStatus::kIoError,
                 std::string("cannot read the configuration descriptor: ") + libusb_error_name(rc));
   }
-  const libusb_interface_descriptor* interface = nullptr;
-  for (int i = 0; i < config->bNumInterfaces; ++i) {
-    const libusb_interface& candidate = config->interface[i];
-    if (candidate.num_altsetting > 0 &&
-        candidate.altsetting[0].bInterfaceNumber == options_.interface_number) {
-      interface = &candidate.altsetting[0];
-    }
-  }
   const std::string iface = "interface " + std::to_string(options_.interface_number);
-  std::string problem;
   uint8_t out = 0;
   uint8_t in = 0;
-  if (interface == nullptr) {
-    problem = "no " + iface + " (the device has " + std::to_string(config->bNumInterfaces) +
-              " interface" + (config->bNumInterfaces == 1 ? "" : "s") + ")";
-  } else if (interface->bInterfaceClass != LIBUSB_CLASS_VENDOR_SPEC) {
-    char klass[8];
-    std::snprintf(klass, sizeof klass, "0x%02x", interface->bInterfaceClass);
-    problem = iface + " is class " + klass + ", not vendor-specific (0xff)";
-  } else {
-    for (int e = 0; e < interface->bNumEndpoints; ++e) {
-      const libusb_endpoint_descriptor& endpoint = interface->endpoint[e];
-      if ((endpoint.bmAttributes & 0x03) != LIBUSB_ENDPOINT_TRANSFER_TYPE_BULK) continue;
-      uint8_t& slot = (endpoint.bEndpointAddress & LIBUSB_ENDPOINT_IN) != 0 ? in : out;
-      if (slot == 0) slot = endpoint.bEndpointAddress;
-    }
-    if (out == 0 || in == 0) {
-      problem = iface + " has no bulk " + (out == 0 ? "OUT" : "IN") + " endpoint";
-    }
-  }
+  const std::string problem =
+      FindBulkEndpoints(*config, options_.interface_number, iface, &out, &in);
   libusb_free_config_descriptor(config);
   if (!problem.empty()) {
     close_and(Match::kFailed);
@@ -322,16 +368,9 @@ UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
   rc = libusb_claim_interface(handle, options_.interface_number);
   if (rc != 0) {
     close_and(Match::kFailed);
-    switch (rc) {
-      case LIBUSB_ERROR_BUSY:
-        return fail(IoStatus::kBusy, iface + " busy (claimed by another program)");
-      case LIBUSB_ERROR_ACCESS:
-        return fail(IoStatus::kPermissionDenied, "permission denied claiming " + iface);
-      case LIBUSB_ERROR_NO_DEVICE:
-        return fail(IoStatus::kNotFound, "vanished while claiming " + iface);
-      default:
-        return fail(IoStatus::kIoError, "cannot claim " + iface + ": " + libusb_error_name(rc));
-    }
+    std::string text;
+    const IoStatus failed = DescribeClaimFailure(rc, iface, &text);
+    return fail(failed, std::move(text));
   }
   handle_ = handle;
   endpoint_out_ = out;

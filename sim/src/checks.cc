@@ -136,29 +136,37 @@ DrawingComparison CompareDrawing(const std::vector<DrawnPath>& drawn,
   return result;
 }
 
-MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
-                         const std::vector<hal::PenEvent>& pens, const MotionLimitsSi& limits,
-                         double window_s) {
-  MotionReport report;
-  const double tick_s = 1.0 / limits.tick_hz;
-  const double a = limits.accel;
-  const auto violation = [&](const std::string& what) {
-    if (report.violations++ == 0) report.first_violation = what;
-  };
-  const auto describe = [](const char* format, double x, double y, double z) {
-    char text[200];
-    std::snprintf(text, sizeof text, format, x, y, z);
-    return std::string(text);
-  };
+namespace {
 
-  // Moves: completion time and cumulative path length (steps).
+std::string Describe(const char* format, double x, double y, double z) {
+  char text[200];
+  std::snprintf(text, sizeof text, format, x, y, z);
+  return std::string(text);
+}
+
+// The working state of CheckMotion: the report it fills, and the moves'
+// completion times with the cumulative path length (steps) after each.
+struct MotionCheck {
+  const MotionLimitsSi& limits;
+  double tick_s;
+  double a;
+  MotionReport report;
   std::vector<double> time;
   std::vector<double> distance;
+
+  void Violation(const std::string& what) {
+    if (report.violations++ == 0) report.first_violation = what;
+  }
+};
+
+// Records the moves, checking each axis's interval between steps.
+void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
+  MotionReport& report = c.report;
   double total = 0;
   std::array<double, 3> last_step{-1, -1, -1};
   report.min_axis_interval_us = HUGE_VAL;
   const double min_interval_s =
-      std::floor(static_cast<double>(limits.tick_hz) / limits.max_rate) * tick_s;
+      std::floor(static_cast<double>(c.limits.tick_hz) / c.limits.max_rate) * c.tick_s;
   for (const hal::StepDirEvent& e : steps) {
     if (e.axis_mask == 0) continue;
     const double t = e.time_us * 1e-6;
@@ -170,41 +178,48 @@ MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
         const double interval = t - last_step[axis];
         report.min_axis_interval_us = std::min(report.min_axis_interval_us, interval * 1e6);
         if (interval < min_interval_s - 1e-9) {
-          violation(describe("axis %.0f stepped %.1f µs after its previous step (at least %.1f µs)",
-                             axis, interval * 1e6, min_interval_s * 1e6));
+          c.Violation(
+              Describe("axis %.0f stepped %.1f µs after its previous step (at least %.1f µs)", axis,
+                       interval * 1e6, min_interval_s * 1e6));
         }
       }
       last_step[axis] = t;
     }
     total += std::sqrt(static_cast<double>(axes));
-    time.push_back(t);
-    distance.push_back(total);
+    c.time.push_back(t);
+    c.distance.push_back(total);
   }
-  report.moves = time.size();
+  report.moves = c.time.size();
   report.path_length = total;
-  report.duration_s = time.empty() ? 0 : time.back();
-  if (time.empty()) return report;
+  report.duration_s = c.time.empty() ? 0 : c.time.back();
+}
 
-  // Pen changes happen at rest and are followed by the pen delay.
+// Pen changes happen at rest and are followed by the pen delay.
+void CheckPenDelays(const std::vector<hal::PenEvent>& pens, MotionCheck& c) {
   for (const hal::PenEvent& pen : pens) {
     const double t = pen.time_us * 1e-6;
-    const auto after = std::lower_bound(time.begin(), time.end(), t - 1e-9);
-    if (after != time.end() && *after < t + limits.pen_delay_s - 1e-9) {
-      violation(describe("a step %.1f µs after the pen change at %.6f s (pen delay %.0f ms)",
-                         (*after - t) * 1e6, t, limits.pen_delay_s * 1e3));
+    const auto after = std::lower_bound(c.time.begin(), c.time.end(), t - 1e-9);
+    if (after != c.time.end() && *after < t + c.limits.pen_delay_s - 1e-9) {
+      c.Violation(Describe("a step %.1f µs after the pen change at %.6f s (pen delay %.0f ms)",
+                           (*after - t) * 1e6, t, c.limits.pen_delay_s * 1e3));
     }
   }
+}
 
-  // Between two rests (the start, pen changes) the machine starts from rest
-  // and comes to rest: x ≤ a·(t − t0 + 1.5·tick)²/2 after the start, and the
-  // distance left ≤ a·(t1 − t + 1.5·tick)²/2 before the stop. The 1.5 ticks
-  // allow for speed changing in whole ticks: k ticks of a speed that grows
-  // by a·tick each cover a·tick²·k(k+1)/2 ≤ a·((k + 1/2)·tick)²/2.
+// Between two rests (the start, pen changes) the machine starts from rest
+// and comes to rest: x ≤ a·(t − t0 + 1.5·tick)²/2 after the start, and the
+// distance left ≤ a·(t1 − t + 1.5·tick)²/2 before the stop. The 1.5 ticks
+// allow for speed changing in whole ticks: k ticks of a speed that grows
+// by a·tick each cover a·tick²·k(k+1)/2 ≤ a·((k + 1/2)·tick)²/2.
+void CheckRests(const std::vector<hal::PenEvent>& pens, MotionCheck& c) {
+  const std::vector<double>& time = c.time;
+  const std::vector<double>& distance = c.distance;
+  const double a = c.a;
   std::vector<double> rests{0.0};
   for (const hal::PenEvent& pen : pens) rests.push_back(pen.time_us * 1e-6);
   std::size_t k = 0;
   for (std::size_t r = 0; r < rests.size(); ++r) {
-    const double start = r == 0 ? 0.0 : rests[r] + limits.pen_delay_s;
+    const double start = r == 0 ? 0.0 : rests[r] + c.limits.pen_delay_s;
     const bool stops = r + 1 < rests.size();
     const double stop = stops ? rests[r + 1] : HUGE_VAL;
     const std::size_t first = k;
@@ -214,59 +229,78 @@ MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
     const double end = distance[k - 1];
     for (std::size_t i = first; i < k; ++i) {
       const double from_start = distance[i] - base;
-      const double span = time[i] - start + 1.5 * tick_s;
+      const double span = time[i] - start + 1.5 * c.tick_s;
       if (from_start > 0.5 * a * span * span + 1e-9) {
-        violation(
-            describe("%.2f steps covered %.6f s after a start from rest (accel limit allows %.2f)",
+        c.Violation(
+            Describe("%.2f steps covered %.6f s after a start from rest (accel limit allows %.2f)",
                      from_start, span, 0.5 * a * span * span));
       }
       if (stops) {
         const double left = end - distance[i];
-        const double until = stop - time[i] + 1.5 * tick_s;
+        const double until = stop - time[i] + 1.5 * c.tick_s;
         if (left > 0.5 * a * until * until + 1e-9) {
-          violation(
-              describe("%.2f steps left %.6f s before a stop at rest (accel limit allows %.2f)",
+          c.Violation(
+              Describe("%.2f steps left %.6f s before a stop at rest (accel limit allows %.2f)",
                        left, until, 0.5 * a * until * until));
         }
       }
     }
   }
+}
 
-  // Speed over windows of at least window_s: x_j − x_i ≤ v·(t_j − t_i) + 1
-  // (the phase carried into and out of the window is below one step).
+// Speed over windows of at least window_s: x_j − x_i ≤ v·(t_j − t_i) + 1
+// (the phase carried into and out of the window is below one step).
+void CheckWindowSpeed(double window_s, MotionCheck& c) {
   std::size_t i = 0;
-  for (std::size_t j = 0; j < time.size(); ++j) {
-    while (i + 1 < j && time[j] - time[i + 1] >= window_s) ++i;
-    const double span = time[j] - time[i];
+  for (std::size_t j = 0; j < c.time.size(); ++j) {
+    while (i + 1 < j && c.time[j] - c.time[i + 1] >= window_s) ++i;
+    const double span = c.time[j] - c.time[i];
     if (span < window_s) continue;
-    const double covered = distance[j] - distance[i];
-    report.max_speed = std::max(report.max_speed, covered / span);
-    if (covered > limits.max_rate * span + 1.0 + 1e-9) {
-      violation(describe("%.1f steps in %.6f s: faster than %.0f steps/s", covered, span,
-                         limits.max_rate));
+    const double covered = c.distance[j] - c.distance[i];
+    c.report.max_speed = std::max(c.report.max_speed, covered / span);
+    if (covered > c.limits.max_rate * span + 1.0 + 1e-9) {
+      c.Violation(Describe("%.1f steps in %.6f s: faster than %.0f steps/s", covered, span,
+                           c.limits.max_rate));
     }
   }
+}
 
-  // Windowed acceleration: average speeds of neighbouring windows differ by
-  // at most a·W; each estimate errs by under 2·√3/W (a move in progress at
-  // each end), so the test allows a·W + 4·√3/W.
+// Windowed acceleration: average speeds of neighbouring windows differ by
+// at most a·W; each estimate errs by under 2·√3/W (a move in progress at
+// each end), so the test allows a·W + 4·√3/W.
+void CheckWindowAccel(double window_s, MotionCheck& c) {
+  const std::vector<double>& time = c.time;
   const auto distance_at = [&](double t) {
     const auto it = std::upper_bound(time.begin(), time.end(), t);
-    return it == time.begin() ? 0.0 : distance[static_cast<std::size_t>(it - time.begin()) - 1];
+    return it == time.begin() ? 0.0 : c.distance[static_cast<std::size_t>(it - time.begin()) - 1];
   };
-  const double allowance = a * window_s + 4 * std::sqrt(3.0) / window_s;
+  const double allowance = c.a * window_s + 4 * std::sqrt(3.0) / window_s;
   double previous = 0;
   for (double t = 0; t < time.back(); t += window_s) {
     const double speed = (distance_at(t + window_s) - distance_at(t)) / window_s;
     const double change = std::fabs(speed - previous);
-    report.max_accel = std::max(report.max_accel, change / window_s);
+    c.report.max_accel = std::max(c.report.max_accel, change / window_s);
     if (change > allowance + 1e-9) {
-      violation(describe("the speed changed by %.1f steps/s within %.3f s (allowed %.1f)", change,
-                         window_s, allowance));
+      c.Violation(Describe("the speed changed by %.1f steps/s within %.3f s (allowed %.1f)", change,
+                           window_s, allowance));
     }
     previous = speed;
   }
-  return report;
+}
+
+}  // namespace
+
+MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
+                         const std::vector<hal::PenEvent>& pens, const MotionLimitsSi& limits,
+                         double window_s) {
+  MotionCheck check{limits, 1.0 / limits.tick_hz, limits.accel, {}, {}, {}};
+  TraceMoves(steps, check);
+  if (check.time.empty()) return check.report;
+  CheckPenDelays(pens, check);
+  CheckRests(pens, check);
+  CheckWindowSpeed(window_s, check);
+  CheckWindowAccel(window_s, check);
+  return check.report;
 }
 
 }  // namespace fdsurf::sim

@@ -106,19 +106,74 @@ void SimulatedPlotter::ScheduleUnplug(std::uint64_t at_us, std::uint64_t back_us
   replug_at_us_ = back_us;
 }
 
+namespace {
+
+// The host's PC end of the link during Run: it takes replies, then sends
+// what the HostLink wants sent, through the faults injected towards the
+// device; a lost port is reconnected and the link resumed.
+class HostSide {
+ public:
+  HostSide(hal::Transport& port, FaultRates to_device, std::uint64_t seed, std::uint64_t tick_us)
+      : port_(port), to_device_(to_device, seed), tick_us_(tick_us) {}
+
+  void Service(host::HostLink& link, std::uint64_t now) {
+    if (down_) {
+      if (port_.Reconnect(0) == hal::IoStatus::kOk) {
+        down_ = false;
+        link.Resume();
+        next_poll_ = now;
+      }
+      return;
+    }
+    for (;;) {
+      std::size_t got = 0;
+      const hal::IoStatus read = port_.Read(in_, sizeof in_, &got, 0);
+      if (read == hal::IoStatus::kDisconnected) down_ = true;
+      if (read != hal::IoStatus::kOk) break;
+      link.OnBytes(in_, got, now);
+      next_poll_ = now;  // an acknowledgement may open the window
+    }
+    if (!down_ && now >= next_poll_) Send(link, now);
+  }
+
+  const FaultStats& fault_stats() const { return to_device_.stats(); }
+
+ private:
+  // The host's PC polls its port about every millisecond.
+  static constexpr std::uint64_t kHostPollUs = 1000;
+
+  void Send(host::HostLink& link, std::uint64_t now) {
+    out_.clear();
+    link.Poll(now, &out_);
+    if (!out_.empty()) {
+      faulted_.clear();
+      to_device_.Process(out_.data(), out_.size(), &faulted_);
+      if (!faulted_.empty() &&
+          port_.Write(faulted_.data(), faulted_.size(), 0) == hal::IoStatus::kDisconnected) {
+        down_ = true;
+      }
+    }
+    next_poll_ = std::max(now + tick_us_, std::min(link.NextPollUs(now), now + kHostPollUs));
+  }
+
+  hal::Transport& port_;
+  FaultLink to_device_;
+  std::uint64_t tick_us_;
+  std::vector<std::uint8_t> out_;
+  std::vector<std::uint8_t> faulted_;
+  std::uint8_t in_[512] = {};
+  bool down_ = false;
+  std::uint64_t next_poll_ = 0;
+};
+
+}  // namespace
+
 RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_us,
                                 const std::function<void(const RunProgress&)>& progress,
                                 std::uint64_t progress_interval_us) {
   const std::uint64_t tick_us = 1'000'000 / options_.tick_hz;
-  // The host's PC polls its port about every millisecond.
-  constexpr std::uint64_t kHostPollUs = 1000;
-  FaultLink to_device(options_.to_device, options_.fault_seed);
-  std::vector<std::uint8_t> out;
-  std::vector<std::uint8_t> faulted;
-  std::uint8_t in[512];
-  bool host_down = false;
+  HostSide host(link_.host(), options_.to_device, options_.fault_seed, tick_us);
   bool device_down = false;
-  std::uint64_t next_host_poll = 0;
   std::uint64_t next_progress = progress_interval_us;
 
   RunResult result;
@@ -132,36 +187,7 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
       link_.PlugInAt(replug_at_us_);
     }
 
-    // The host: take replies, then send what the link wants sent.
-    if (host_down) {
-      if (link_.host().Reconnect(0) == hal::IoStatus::kOk) {
-        host_down = false;
-        link.Resume();
-        next_host_poll = now;
-      }
-    } else {
-      for (;;) {
-        std::size_t got = 0;
-        const hal::IoStatus read = link_.host().Read(in, sizeof in, &got, 0);
-        if (read == hal::IoStatus::kDisconnected) host_down = true;
-        if (read != hal::IoStatus::kOk) break;
-        link.OnBytes(in, got, now);
-        next_host_poll = now;  // an acknowledgement may open the window
-      }
-      if (!host_down && now >= next_host_poll) {
-        out.clear();
-        link.Poll(now, &out);
-        if (!out.empty()) {
-          faulted.clear();
-          to_device.Process(out.data(), out.size(), &faulted);
-          if (!faulted.empty() && link_.host().Write(faulted.data(), faulted.size(), 0) ==
-                                      hal::IoStatus::kDisconnected) {
-            host_down = true;
-          }
-        }
-        next_host_poll = std::max(now + tick_us, std::min(link.NextPollUs(now), now + kHostPollUs));
-      }
-    }
+    host.Service(link, now);
 
     // The device: its main loop, then one tick of its step timer.
     if (device_down) {
@@ -191,7 +217,7 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
   result.host = link.stats();
   result.device = runner_->link_stats();
   result.device_frames = runner_->frame_stats();
-  result.faults_to_device = to_device.stats();
+  result.faults_to_device = host.fault_stats();
   result.faults_to_host = device_end_->stats();
   return result;
 }

@@ -640,27 +640,31 @@ Transition TransitionSurface(const Patch& a, const Patch& b, double k_a, double 
 
 // ---- Row 10 -------------------------------------------------------------------
 
-std::vector<EdgeJoin> CheckBezierJoins(const std::vector<Patch>& patches, double tolerance,
-                                       double angle_deg, double ratio) {
-  struct Edge {
-    std::size_t patch;
-    const char* name;
-    std::array<Point3, 4> on;     // the edge's control points
-    std::array<Point3, 4> inner;  // the next row inward, point by point
-  };
-  std::vector<Edge> edges;
-  double scale = 1;
+namespace {
+
+// A patch's boundary edge in Bézier form.
+struct PatchEdge {
+  std::size_t patch;
+  const char* name;
+  std::array<Point3, 4> on;     // the edge's control points
+  std::array<Point3, 4> inner;  // the next row inward, point by point
+};
+
+// The four boundary edges of every patch, and in *scale the largest
+// coordinate of any control point (at least 1), the tolerance's unit.
+std::vector<PatchEdge> BoundaryEdges(const std::vector<Patch>& patches, double* scale) {
+  std::vector<PatchEdge> edges;
   for (std::size_t p = 0; p < patches.size(); ++p) {
     const Patch b = ToBezier(patches[p]);
     for (const auto& row : b.g) {
       for (const Point3& x : row) {
-        for (double v : x) scale = std::max(scale, std::fabs(v));
+        for (double v : x) *scale = std::max(*scale, std::fabs(v));
       }
     }
-    Edge e0{p, "s=0", {}, {}};
-    Edge e1{p, "s=1", {}, {}};
-    Edge e2{p, "t=0", {}, {}};
-    Edge e3{p, "t=1", {}, {}};
+    PatchEdge e0{p, "s=0", {}, {}};
+    PatchEdge e1{p, "s=1", {}, {}};
+    PatchEdge e2{p, "t=0", {}, {}};
+    PatchEdge e3{p, "t=1", {}, {}};
     for (int k = 0; k < 4; ++k) {
       e0.on[k] = b.g[0][k];
       e0.inner[k] = b.g[1][k];
@@ -676,13 +680,59 @@ std::vector<EdgeJoin> CheckBezierJoins(const std::vector<Patch>& patches, double
     edges.push_back(e2);
     edges.push_back(e3);
   }
+  return edges;
+}
+
+// How two coinciding edges join: the angle and length ratio between the legs
+// from each edge's control points to the next row inward, row by row (ea's
+// point k against eb's point k, or 3 − k when eb runs backward).
+EdgeJoin MeasureEdgeJoin(const PatchEdge& ea, const PatchEdge& eb, bool forward, double tol,
+                         double angle_deg, double ratio) {
+  EdgeJoin join;
+  join.patch_a = ea.patch;
+  join.patch_b = eb.patch;
+  join.edge_a = ea.name;
+  join.edge_b = eb.name;
+  int rows = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int kb = forward ? k : 3 - k;
+    const Point3 leg_a = Sub(ea.on[k], ea.inner[k]);
+    const Point3 leg_b = Sub(eb.inner[kb], eb.on[kb]);
+    const double la = Norm(leg_a);
+    const double lb = Norm(leg_b);
+    if (la <= tol || lb <= tol) {
+      ++join.degenerate_rows;
+      continue;
+    }
+    ++rows;
+    const double angle =
+        std::atan2(Norm(Cross(leg_a, leg_b)), Dot(leg_a, leg_b)) * 180 / std::numbers::pi;
+    join.worst_angle_deg = std::max(join.worst_angle_deg, angle);
+    join.worst_ratio_error = std::max(join.worst_ratio_error, std::fabs(lb / la - 1));
+  }
+  if (rows == 0) {
+    join.join = "degenerate";
+  } else if (join.worst_angle_deg > angle_deg) {
+    join.join = "C0";
+  } else {
+    join.join = join.worst_ratio_error <= ratio ? "C1" : "G1";
+  }
+  return join;
+}
+
+}  // namespace
+
+std::vector<EdgeJoin> CheckBezierJoins(const std::vector<Patch>& patches, double tolerance,
+                                       double angle_deg, double ratio) {
+  double scale = 1;
+  const std::vector<PatchEdge> edges = BoundaryEdges(patches, &scale);
   const double tol = tolerance * scale;
   const auto same = [&](const Point3& x, const Point3& y) { return Norm(Sub(x, y)) <= tol; };
   std::vector<EdgeJoin> joins;
   for (std::size_t x = 0; x < edges.size(); ++x) {
     for (std::size_t y = x + 1; y < edges.size(); ++y) {
-      const Edge& ea = edges[x];
-      const Edge& eb = edges[y];
+      const PatchEdge& ea = edges[x];
+      const PatchEdge& eb = edges[y];
       bool forward = true;
       bool backward = true;
       for (int k = 0; k < 4; ++k) {
@@ -694,36 +744,7 @@ std::vector<EdgeJoin> CheckBezierJoins(const std::vector<Patch>& patches, double
       if (same(ea.on[0], ea.on[3]) && same(ea.on[0], ea.on[1]) && same(ea.on[0], ea.on[2])) {
         continue;
       }
-      EdgeJoin join;
-      join.patch_a = ea.patch;
-      join.patch_b = eb.patch;
-      join.edge_a = ea.name;
-      join.edge_b = eb.name;
-      int rows = 0;
-      for (int k = 0; k < 4; ++k) {
-        const int kb = forward ? k : 3 - k;
-        const Point3 leg_a = Sub(ea.on[k], ea.inner[k]);
-        const Point3 leg_b = Sub(eb.inner[kb], eb.on[kb]);
-        const double la = Norm(leg_a);
-        const double lb = Norm(leg_b);
-        if (la <= tol || lb <= tol) {
-          ++join.degenerate_rows;
-          continue;
-        }
-        ++rows;
-        const double angle =
-            std::atan2(Norm(Cross(leg_a, leg_b)), Dot(leg_a, leg_b)) * 180 / std::numbers::pi;
-        join.worst_angle_deg = std::max(join.worst_angle_deg, angle);
-        join.worst_ratio_error = std::max(join.worst_ratio_error, std::fabs(lb / la - 1));
-      }
-      if (rows == 0) {
-        join.join = "degenerate";
-      } else if (join.worst_angle_deg > angle_deg) {
-        join.join = "C0";
-      } else {
-        join.join = join.worst_ratio_error <= ratio ? "C1" : "G1";
-      }
-      joins.push_back(join);
+      joins.push_back(MeasureEdgeJoin(ea, eb, forward, tol, angle_deg, ratio));
     }
   }
   return joins;
