@@ -13,6 +13,7 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quantum.h"
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/text.h"
 
 namespace fdsurf::host {
 namespace {
@@ -36,12 +37,6 @@ class Output {
  private:
   std::string buffer_;
 };
-
-std::string FormatDouble(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", v);
-  return text;
-}
 
 }  // namespace
 
@@ -75,8 +70,8 @@ int RunSample(const GridOptions& options) {
           const Point3 v = EvaluateReference(set.patches[p], static_cast<double>(i) / grid.steps_s,
                                              static_cast<double>(j) / grid.steps_t);
           out.Append(prefix + std::to_string(i) + "," + std::to_string(j) + "," +
-                     FormatDouble(v[0]) + "," + FormatDouble(v[1]) + "," + FormatDouble(v[2]) +
-                     "\n");
+                     FormatNumber(v[0], 17) + "," + FormatNumber(v[1], 17) + "," +
+                     FormatNumber(v[2], 17) + "\n");
         }
       }
     }

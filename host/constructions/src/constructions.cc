@@ -7,22 +7,11 @@
 #include <numbers>
 
 #include "fdsurf/host/reference.h"
+#include "fdsurf/host/text.h"
 #include "fdsurf/host/vec3.h"
 
 namespace fdsurf::host {
 namespace {
-
-std::string Format(const Point3& p) {
-  char text[96];
-  std::snprintf(text, sizeof text, "(%.9g, %.9g, %.9g)", p[0], p[1], p[2]);
-  return text;
-}
-
-std::string Format(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", v);
-  return text;
-}
 
 Poly Multiply(const Poly& a, const Poly& b) {
   Poly product(a.size() + b.size() - 1, 0.0);
@@ -152,8 +141,8 @@ void CheckIncreasing(const std::vector<double>& nodes, const char* name) {
     }
     if (k > 0 && !(nodes[k] > nodes[k - 1])) {
       throw ConstructionError(std::string(name) + "[" + std::to_string(k) +
-                              "] = " + Format(nodes[k]) + " is not greater than " + name + "[" +
-                              std::to_string(k - 1) + "] = " + Format(nodes[k - 1]) +
+                              "] = " + FormatNumber(nodes[k], 9) + " is not greater than " + name +
+                              "[" + std::to_string(k - 1) + "] = " + FormatNumber(nodes[k - 1], 9) +
                               " (parameters must increase)");
     }
   }
@@ -283,8 +272,8 @@ double AppendPatches(const PolySurface& surface, double tolerance, const std::st
     if (ks > kMaxPieces || kt > kMaxPieces) {
       throw ConstructionError("the surface has degree > 3 and needs more than " +
                               std::to_string(kMaxPieces) +
-                              " bicubic pieces per direction for tolerance " + Format(tolerance) +
-                              "; give a larger \"tolerance\"");
+                              " bicubic pieces per direction for tolerance " +
+                              FormatNumber(tolerance, 9) + "; give a larger \"tolerance\"");
     }
   }
   const double hs = 1.0 / ks;
@@ -408,12 +397,12 @@ PolySurface CoonsPatch(const Curve& r1, const Curve& r2, const Curve& r3, const 
     const Point3 pb = EvaluateCurve(*boundary[c.b], c.v);
     const double gap = Norm(Sub(pa, pb));
     if (!(gap <= tolerance * scale)) {
-      throw ConstructionError(std::string("corner ") + c.name + ": boundary " +
-                              std::to_string(c.a) + " (" + kBoundaryName[c.a] + ") " +
-                              (c.u == 0 ? "starts" : "ends") + " at " + Format(pa) +
-                              " but boundary " + std::to_string(c.b) + " (" + kBoundaryName[c.b] +
-                              ") " + (c.v == 0 ? "starts" : "ends") + " at " + Format(pb) + ", " +
-                              Format(gap) + " apart (tolerance " + Format(tolerance * scale) + ")");
+      throw ConstructionError(
+          std::string("corner ") + c.name + ": boundary " + std::to_string(c.a) + " (" +
+          kBoundaryName[c.a] + ") " + (c.u == 0 ? "starts" : "ends") + " at " + FormatPoint(pa) +
+          " but boundary " + std::to_string(c.b) + " (" + kBoundaryName[c.b] + ") " +
+          (c.v == 0 ? "starts" : "ends") + " at " + FormatPoint(pb) + ", " + FormatNumber(gap, 9) +
+          " apart (tolerance " + FormatNumber(tolerance * scale, 9) + ")");
     }
     corner_point[k] = pa;
   }

@@ -9,18 +9,13 @@
 #include <numbers>
 
 #include "fdsurf/host/constructions.h"
+#include "fdsurf/host/text.h"
 #include "fdsurf/host/vec3.h"
 
 namespace fdsurf::host {
 namespace {
 
 Point3 Unit(const Point3& a) { return Scale(a, 1 / Norm(a)); }
-
-std::string Format(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
 
 // The angle in degrees between two lines (directions up to sign).
 double LineAngle(const Point3& a, const Point3& b) {
@@ -278,14 +273,15 @@ std::string PieceNote(const std::string& origin, const std::string& name, const 
         free_count == 1 ? ": free" : ", degenerate (more than the usual one free parameter): free";
     for (std::size_t k = 0; k < free_count; ++k) {
       note += std::string(k ? "," : "") + " " + kQuadricUnknowns[piece.solution.free_unknowns[k]] +
-              " = " + Format(piece.parameters[k]);
+              " = " + FormatNumber(piece.parameters[k]);
     }
   }
   const auto& m = piece.quadric.m;
-  note += "; F = " + Format(m[0][0]) + "·dx² + " + Format(m[1][1]) + "·dy² + " + Format(m[2][2]) +
-          "·dz² + " + Format(2 * m[0][1]) + "·dx·dy + " + Format(2 * m[0][2]) + "·dx·dz + " +
-          Format(2 * m[1][2]) + "·dy·dz + 2·(" + Format(a1[0]) + "·dx + " + Format(a1[1]) +
-          "·dy + " + Format(a1[2]) + "·dz), d = X − vertex " + std::to_string(first_vertex);
+  note += "; F = " + FormatNumber(m[0][0]) + "·dx² + " + FormatNumber(m[1][1]) + "·dy² + " +
+          FormatNumber(m[2][2]) + "·dz² + " + FormatNumber(2 * m[0][1]) + "·dx·dy + " +
+          FormatNumber(2 * m[0][2]) + "·dx·dz + " + FormatNumber(2 * m[1][2]) + "·dy·dz + 2·(" +
+          FormatNumber(a1[0]) + "·dx + " + FormatNumber(a1[1]) + "·dy + " + FormatNumber(a1[2]) +
+          "·dz), d = X − vertex " + std::to_string(first_vertex);
   return note;
 }
 
@@ -552,7 +548,7 @@ void AddSlicer(QuadricBuild& b, std::size_t t, int va, int vb, const Point3& pla
         b.origin + ": triangles[" + std::to_string(t) +
         "]: the piece does not close below its triangle (the glue curve is unbounded); "
         "drawn down to depth " +
-        Format(depth));
+        FormatNumber(depth));
   }
   sl.depth = depth;
   b.slicers.push_back(sl);
@@ -732,7 +728,7 @@ void Tessellate(QuadricBuild& b) {
     if (n > kMaxCells) {
       throw ConstructionError("the tessellation needs more than " + std::to_string(kMaxCells) +
                               "x" + std::to_string(kMaxCells) + " cells per piece for tolerance " +
-                              Format(b.tolerance));
+                              FormatNumber(b.tolerance));
     }
     Tessellation attempt;
     for (const Slicer& sl : b.slicers) TessellatePiece(sl, n, b.origin, &attempt);
@@ -771,18 +767,20 @@ void MeasureGlue(const QuadricBuild& b, QuadricGlue& glue) {
 }
 
 std::string GlueNote(const std::string& origin, const QuadricGlue& glue) {
-  std::string note = origin + ": glue triangles " + std::to_string(glue.triangle_a) + " and " +
-                     std::to_string(glue.triangle_b) + " along vertices " +
-                     std::to_string(glue.vertex_a) + "-" + std::to_string(glue.vertex_b) +
-                     ": plane with normal (" + Format(glue.plane_normal[0]) + ", " +
-                     Format(glue.plane_normal[1]) + ", " + Format(glue.plane_normal[2]) + "), ";
+  std::string note =
+      origin + ": glue triangles " + std::to_string(glue.triangle_a) + " and " +
+      std::to_string(glue.triangle_b) + " along vertices " + std::to_string(glue.vertex_a) + "-" +
+      std::to_string(glue.vertex_b) + ": plane with normal (" + FormatNumber(glue.plane_normal[0]) +
+      ", " + FormatNumber(glue.plane_normal[1]) + ", " + FormatNumber(glue.plane_normal[2]) + "), ";
   if (!glue.conics_coincide) {
-    note += "no plane where both pieces cut the same conic (gap up to " + Format(glue.gap) + ")";
+    note +=
+        "no plane where both pieces cut the same conic (gap up to " + FormatNumber(glue.gap) + ")";
   } else if (glue.worst_normal_angle_deg <= 1e-6) {
     note += "tangent-plane continuous (G1)";
   } else {
     note += "only continuous (C0): the normals differ by up to " +
-            Format(glue.worst_normal_angle_deg) + " degrees (gap " + Format(glue.gap) + ")";
+            FormatNumber(glue.worst_normal_angle_deg) + " degrees (gap " + FormatNumber(glue.gap) +
+            ")";
   }
   return note;
 }
@@ -801,8 +799,8 @@ void ReportJoins(QuadricBuild& b) {
                               ? ", " + std::to_string(result.missing_cells) +
                                     " cells left out where a slice misses the surface"
                               : std::string()) +
-                         "), largest sampled deviation " + Format(result.tessellation_error) +
-                         " (tolerance " + Format(b.tolerance) + ")");
+                         "), largest sampled deviation " + FormatNumber(result.tessellation_error) +
+                         " (tolerance " + FormatNumber(b.tolerance) + ")");
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "fdsurf/host/constructions.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quadric_hermite.h"
+#include "fdsurf/host/text.h"
 
 namespace fdsurf::host {
 namespace {
@@ -15,12 +16,6 @@ namespace {
 using nlohmann::json;
 
 using Place = JsonPlace;
-
-std::string Format(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", v);
-  return text;
-}
 
 void CheckFields(const json& object, const Place& place, std::initializer_list<const char*> allowed,
                  std::initializer_list<const char*> required) {
@@ -162,8 +157,8 @@ void Append(const PolySurface& surface, double tolerance, const std::string& ori
     set->notes.push_back(origin + ": degree " + std::to_string(surface.c.size() - 1) + "x" +
                          std::to_string(surface.c[0].size() - 1) + " approximated by " +
                          std::to_string(set->patches.size() - before) +
-                         " bicubic Hermite pieces within " + Format(bound) + " (tolerance " +
-                         Format(tolerance) + ")");
+                         " bicubic Hermite pieces within " + FormatNumber(bound, 9) +
+                         " (tolerance " + FormatNumber(tolerance, 9) + ")");
   }
 }
 
@@ -347,8 +342,8 @@ void AddTransition(const json& e, const Place& place, PatchSet* set) {
     const std::string origin = SegmentOrigin(place, 0, 1);
     Append(t.surface, 1, origin, set);
     set->notes.push_back(origin + ": transition from patch " + std::to_string(a) +
-                         " (t = 1) to patch " + std::to_string(b) +
-                         " (t = 0), k_a = " + Format(t.k_a) + ", k_b = " + Format(t.k_b));
+                         " (t = 1) to patch " + std::to_string(b) + " (t = 0), k_a = " +
+                         FormatNumber(t.k_a, 9) + ", k_b = " + FormatNumber(t.k_b, 9));
   } catch (const ConstructionError& error) {
     throw place.Error(error.what());
   }
@@ -424,9 +419,9 @@ std::string PolyText(const VecPoly& p, int c) {
   for (int k = 0; k < 4; ++k) {
     const double v = p[k][c];
     if (text.empty()) {
-      text = Format(v) + kPower[k];
+      text = FormatNumber(v, 9) + kPower[k];
     } else {
-      text += (v < 0 ? " - " : " + ") + Format(std::fabs(v)) + kPower[k];
+      text += (v < 0 ? " - " : " + ") + FormatNumber(std::fabs(v), 9) + kPower[k];
     }
   }
   return text;
@@ -490,8 +485,8 @@ void AddCurve(const json& e, const Place& place, PatchSet* set) {
   for (std::size_t k = 0; k < chain.joins.size(); ++k) {
     const Point3& p = points[k + 1];
     set->notes.push_back(place.file + ": " + place.path + ": join " + std::to_string(k + 1) +
-                         " at (" + Format(p[0]) + ", " + Format(p[1]) + ", " + Format(p[2]) +
-                         "): " + JoinClassName(chain.joins[k]));
+                         " at (" + FormatNumber(p[0], 9) + ", " + FormatNumber(p[1], 9) + ", " +
+                         FormatNumber(p[2], 9) + "): " + JoinClassName(chain.joins[k]));
   }
 }
 

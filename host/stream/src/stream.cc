@@ -147,7 +147,7 @@ protocol::Command PatchCommandFor(const Patch& patch, const ToolpathOptions& t,
 // pen-up move only where a curve does not start where the one before ended
 // (so a chain is drawn in one stroke).
 void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
-               StreamJob* job) {
+                      StreamJob* job) {
   bool pen_down = false;
   bool placed = false;
   std::array<std::int32_t, 3> at{};

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/host/writers.h"
+#include "fdsurf/host/text.h"
 
 #include <cairo.h>
 
@@ -15,12 +16,6 @@ namespace {
 // The page size in whole quanta, so that flipped coordinates stay exact.
 std::int64_t PageQuanta(double size, const Quantum& q) {
   return static_cast<std::int64_t>(std::ceil(q.ToQuanta(size) - 1e-9));
-}
-
-std::string Trimmed(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
 }
 
 std::string XmlEscaped(const std::string& text) {
@@ -62,7 +57,7 @@ std::string WriteSvg(const Toolpath& path, const std::string& title) {
       << R"(" height=")" << height << path.units << R"(" viewBox="0 0 )" << width << " " << height
       << "\">\n"
       << "<title>" << XmlEscaped(title) << "</title>\n"
-      << R"(<g fill="none" stroke="black" stroke-width=")" << Trimmed(pen)
+      << R"(<g fill="none" stroke="black" stroke-width=")" << FormatNumber(pen)
       << R"(" stroke-linecap="round" stroke-linejoin="round">)"
       << "\n";
   for (const Stroke& s : path.strokes) {
@@ -88,9 +83,9 @@ std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
       << "G90 ; absolute positions\n";
   const auto pen_up = [&] {
     if (z_pen || three_d) {
-      out << "G0 Z" << Trimmed(options.pen_up_z) << "\n";
+      out << "G0 Z" << FormatNumber(options.pen_up_z) << "\n";
     } else {
-      out << "M5\nG4 P" << Trimmed(options.dwell) << "\n";
+      out << "M5\nG4 P" << FormatNumber(options.dwell) << "\n";
     }
   };
   pen_up();
@@ -98,16 +93,17 @@ std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
     const auto& first = s.points.front();
     out << "G0 X" << q.Format(first[0]) << " Y" << q.Format(first[1]) << "\n";
     if (three_d) {
-      out << "G1 Z" << q.Format(first[2]) << " F" << Trimmed(options.plunge_feed) << "\n";
+      out << "G1 Z" << q.Format(first[2]) << " F" << FormatNumber(options.plunge_feed) << "\n";
     } else if (z_pen) {
-      out << "G1 Z" << Trimmed(options.pen_down_z) << " F" << Trimmed(options.plunge_feed) << "\n";
+      out << "G1 Z" << FormatNumber(options.pen_down_z) << " F" << FormatNumber(options.plunge_feed)
+          << "\n";
     } else {
-      out << "M3 S" << options.power << "\nG4 P" << Trimmed(options.dwell) << "\n";
+      out << "M3 S" << options.power << "\nG4 P" << FormatNumber(options.dwell) << "\n";
     }
     for (std::size_t k = 1; k < s.points.size(); ++k) {
       out << "G1 X" << q.Format(s.points[k][0]) << " Y" << q.Format(s.points[k][1]);
       if (three_d) out << " Z" << q.Format(s.points[k][2]);
-      if (k == 1) out << " F" << Trimmed(options.feed);
+      if (k == 1) out << " F" << FormatNumber(options.feed);
       out << "\n";
     }
     pen_up();

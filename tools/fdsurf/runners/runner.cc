@@ -37,7 +37,7 @@ void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const S
 }
 
 void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64_t frames,
-                      double machine_seconds, bool force) {
+                        double machine_seconds, bool force) {
   if (!enabled_) return;
   const auto now = Clock::now();
   if (!force && shown_ && now - last_ < std::chrono::milliseconds(100)) return;
@@ -57,10 +57,10 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
     std::snprintf(rate, sizeof rate, "%.2f commands/s",
                   wall > 0 ? static_cast<double>(executed) / wall : 0.0);
   }
-  std::fprintf(
-      stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
-      bar.c_str(), percent, static_cast<unsigned long long>(executed),
-      static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate);
+  std::fprintf(stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
+               bar.c_str(), percent, static_cast<unsigned long long>(executed),
+               static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames),
+               rate);
   shown_ = true;
 }
 

@@ -151,7 +151,8 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   const std::size_t gcode_bytes = GcodeBytes(set, drawing, units);
   const std::string what =
       std::to_string(job.patches.size()) + " patches" +
-      (job.curves.empty() ? std::string() : " and " + std::to_string(job.curves.size()) + " curves");
+      (job.curves.empty() ? std::string()
+                          : " and " + std::to_string(job.curves.size()) + " curves");
   std::fprintf(stderr,
                "%s: %s streamed to the simulated plotter (%u axes, %u Hz ticks); %zu shared edges "
                "drawn once\n",
@@ -182,9 +183,9 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                comparison.max_deviation, comparison.max_deviation * step, units.c_str(),
                comparison.max_gap, checked.bound, checked.within ? "within" : "BOUND VIOLATED");
   const std::string limits =
-      checked.limits_kept ? std::string("kept")
-                          : std::to_string(motion.violations) +
-                                " violations, first: " + motion.first_violation;
+      checked.limits_kept
+          ? std::string("kept")
+          : std::to_string(motion.violations) + " violations, first: " + motion.first_violation;
   std::fprintf(stderr, "motion limits (%.0f %s/s, %.0f %s/s², pen delay %d ms): %s\n", o.speed,
                units.c_str(), o.accel, units.c_str(), o.pen_delay_ms, limits.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
