@@ -56,6 +56,21 @@ constexpr int kGeometryFracBits = 16;
 using GeometryFixed = Fixed<int64_t, kGeometryFracBits>;
 constexpr int64_t kGeometryLimitRaw = int64_t{1} << (31 + kGeometryFracBits);
 
+/// The one range check of geometry: |raw| < kGeometryLimitRaw (2^31 quanta).
+/// The decoder refuses a value outside it (kBadField) and the set-up
+/// (PreparePatch, CurvePowerCoefficients, IsolineWalker, and
+/// PrepareAdaptiveCurve for power coefficients in the same Q47.16) with
+/// kGeometryOutOfRange, so every side applies the same bound.
+constexpr bool GeometryInRange(int64_t raw) {
+  return raw > -kGeometryLimitRaw && raw < kGeometryLimitRaw;
+}
+constexpr bool GeometryInRange(GeometryFixed value) { return GeometryInRange(value.Raw()); }
+
+static_assert(GeometryInRange(kGeometryLimitRaw - 1) && GeometryInRange(-(kGeometryLimitRaw - 1)),
+              "the largest magnitude inside the range");
+static_assert(!GeometryInRange(kGeometryLimitRaw) && !GeometryInRange(-kGeometryLimitRaw),
+              "2^31 quanta is outside");
+
 /// Output positions: whole quanta, Q31.0.
 using Quanta = Fixed<int32_t, 0>;
 
