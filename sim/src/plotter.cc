@@ -196,7 +196,7 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
       device_down = runner_->Service(*device_end_) == hal::IoStatus::kDisconnected;
     }
     runner_->Fill();
-    runner_->Tick(steps_, pen_);
+    (void)runner_->Tick(steps_, pen_);  // a failed output faults the device: the host sees kFault
     clock_.Advance(tick_us);
 
     if (progress && now >= next_progress) {

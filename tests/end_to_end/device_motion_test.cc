@@ -534,7 +534,7 @@ TEST_F(DeviceTest, StopDropsTheQueueComesToRestAndLiftsThePen) {
   ASSERT_EQ(Accept(BumpPatch(1200, 900, 250, 6), &detail), protocol::ErrorCode::kNone);
   for (int t = 0; t < 200000; ++t) {  // 5 s: well into the first patch
     device_.Fill();
-    device_.Tick(steps_, pen_);
+    ASSERT_EQ(device_.Tick(steps_, pen_), hal::IoStatus::kOk);
     clock_.Advance(25);
   }
   ASSERT_TRUE(pen_.down() || !pen_.events().empty());
@@ -560,7 +560,7 @@ TEST_F(DeviceTest, AFailingOutputFaultsTheDevice) {
   ASSERT_EQ(Accept(BumpPatch(100, 900, 250, 3), &detail), protocol::ErrorCode::kNone);
   for (int t = 0; t < 40000; ++t) {
     device_.Fill();
-    device_.Tick(steps_, pen_);
+    ASSERT_EQ(device_.Tick(steps_, pen_), hal::IoStatus::kOk);
     clock_.Advance(25);
   }
   steps_.InjectError(hal::IoStatus::kIoError);
@@ -576,7 +576,7 @@ TEST_F(DeviceTest, AFailingOutputFaultsTheDevice) {
   EXPECT_EQ(report.error_detail, static_cast<std::uint8_t>(hal::IoStatus::kIoError));
   // Nothing moves after that.
   const std::size_t events = steps_.events().size();
-  for (int t = 0; t < 1000; ++t) device_.Tick(steps_, pen_);
+  for (int t = 0; t < 1000; ++t) (void)device_.Tick(steps_, pen_);  // faulted: only no steps count
   EXPECT_EQ(steps_.events().size(), events);
 }
 

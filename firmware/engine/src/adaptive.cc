@@ -3,6 +3,7 @@
 // derives the level choice, the range bound and the chord test used here.
 #include "fdsurf/adaptive.h"
 
+#include "fdsurf/fixed.h"
 #include "fdsurf/internal/wide_int.h"
 
 namespace fdsurf {
@@ -22,8 +23,6 @@ constexpr int64_t kPreStepAllowance16 = 64;  // 2^-10 quanta
 uint64_t Magnitude(int64_t v) {
   return v < 0 ? ~static_cast<uint64_t>(v) + 1 : static_cast<uint64_t>(v);
 }
-
-bool GeometryInRange(int64_t v) { return v < kGeometryLimitRaw && v > -kGeometryLimitRaw; }
 
 // round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
 // floor((2|x| + ab) / 2ab) by successive floor divisions, which compose.
@@ -56,8 +55,8 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   for (int c = 0; c < kDims; ++c) {
     uint64_t sum = 0;
     for (int k = 0; k < 4; ++k) {
+      if (!GeometryInRange(curve[c].c[k])) return Status::kGeometryOutOfRange;
       m[c][k] = Magnitude(curve[c].c[k]);
-      if (m[c][k] >= static_cast<uint64_t>(kGeometryLimitRaw)) return Status::kGeometryOutOfRange;
       sum += m[c][k];
     }
     // |x(t)| ≤ Σ|coefficients|; with the rounding half it must stay in int32.
@@ -144,7 +143,7 @@ Status CurvePowerCoefficients(const CurveGeometry1 (&geometry)[kDims], Basis bas
   PowerCurve1 result[kDims];
   for (int c = 0; c < kDims; ++c) {
     for (int i = 0; i < 4; ++i) {
-      if (!GeometryInRange(geometry[c].g[i].Raw())) return Status::kGeometryOutOfRange;
+      if (!GeometryInRange(geometry[c].g[i])) return Status::kGeometryOutOfRange;
     }
     for (int k = 0; k < 4; ++k) {
       int64_t scaled = 0;  // |scaled| < 12·2^47
@@ -171,7 +170,7 @@ Status IsolineWalker<kDims>::Create(const PatchGeometry1 (&geometry)[kDims], Bas
   for (const PatchGeometry1& g : geometry) {
     for (const auto& row : g.g) {
       for (const GeometryFixed& value : row) {
-        if (!GeometryInRange(value.Raw())) return Status::kGeometryOutOfRange;
+        if (!GeometryInRange(value)) return Status::kGeometryOutOfRange;
       }
     }
     // d²·2^16·C = (dM)·G·(dM)ᵀ, below 12·12·2^47 < 2^55 in magnitude.

@@ -7,6 +7,7 @@
 // 2^-g quanta (g = kGeometryFracBits).
 #include "fdsurf/forward_difference.h"
 
+#include "fdsurf/fixed.h"
 #include "fdsurf/internal/wide_int.h"
 
 namespace fdsurf {
@@ -194,9 +195,7 @@ struct Plane {
 Status BuildPlane(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Plane* plane) {
   for (int i = 0; i < s.size; ++i) {
     for (int j = 0; j < t.size; ++j) {
-      if (g[i][j] >= kGeometryLimitRaw || g[i][j] <= -kGeometryLimitRaw) {
-        return Status::kGeometryOutOfRange;
-      }
+      if (!GeometryInRange(g[i][j])) return Status::kGeometryOutOfRange;
     }
   }
   int64_t c[4][4];

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -321,6 +322,40 @@ TEST(IsolineWalker, LineCoefficientsAreTheExactlyRoundedOnes) {
       EXPECT_FALSE(walker.Next(curve));
     }
   }
+}
+
+// Each entry point applies GeometryInRange (fixed.h): |raw| < 2^31 quanta.
+TEST(GeometryRange, EveryEntryPointRefusesTheLimitAndAcceptsJustBelowIt) {
+  for (const std::int64_t sign : {1, -1}) {
+    const GeometryFixed inside = GeometryFixed::FromRaw(sign * (kGeometryLimitRaw - 1));
+    const GeometryFixed limit = GeometryFixed::FromRaw(sign * kGeometryLimitRaw);
+
+    // Curve geometry to power coefficients (a constant curve at the value).
+    CurveGeometry1 curve[1] = {{{inside, inside, inside, inside}}};
+    PowerCurve1 power[1];
+    EXPECT_EQ(CurvePowerCoefficients(curve, Basis::kBezier, power), Status::kOk);
+    curve[0].g[2] = limit;
+    EXPECT_EQ(CurvePowerCoefficients(curve, Basis::kBezier, power), Status::kGeometryOutOfRange);
+
+    // The isoline walker: one control value of the patch at the limit.
+    PatchGeometry1 patch[2] = {};
+    IsolineWalker<2> walker;
+    patch[1].g[1][2] = inside;
+    EXPECT_EQ(IsolineWalker<2>::Create(patch, Basis::kBezier, IsolineFamily::kSLines, 4, &walker),
+              Status::kOk);
+    patch[1].g[1][2] = limit;
+    EXPECT_EQ(IsolineWalker<2>::Create(patch, Basis::kBezier, IsolineFamily::kTLines, 4, &walker),
+              Status::kGeometryOutOfRange);
+  }
+
+  // Power coefficients far outside: each magnitude is checked on its own, so
+  // a sum of magnitudes that wraps around in 64 bits cannot pass for small.
+  const std::int64_t most_negative = std::numeric_limits<std::int64_t>::min();
+  PowerCurve1 wrapped[1] = {{{most_negative, most_negative, 0, 0}}};
+  PreparedAdaptiveCurve<1> prepared;
+  AdaptiveSettings settings;
+  settings.tolerance_q8 = 256;
+  EXPECT_EQ(PrepareAdaptiveCurve(wrapped, settings, &prepared), Status::kGeometryOutOfRange);
 }
 
 TEST(IsolineWalker, RefusesBadLineCounts) {

@@ -264,6 +264,26 @@ TEST(PrecisionPlanner, RequiredFracBitsMatchTheDerivation) {
   EXPECT_EQ(RequiredFracBits(1024, 1024), 64);
 }
 
+// A Hermite tangent may be three times the curve it shapes: x(s) = (V/3)·s³
+// has P1 = V/3 and T1 = V. With V at 2^31 quanta the surface (below 2^31/3
+// quanta) fits the output, so only the geometry range (GeometryInRange)
+// refuses it; just below the limit it is accepted.
+TEST(PrecisionPlanner, RefusesGeometryAtTheLimitEvenWhenTheSurfaceFits) {
+  for (const std::int64_t v :
+       {kGeometryLimitRaw - 1, kGeometryLimitRaw, -(kGeometryLimitRaw - 1), -kGeometryLimitRaw}) {
+    RawPatch patch = {};
+    for (int j = 0; j < 2; ++j) {  // P0 = P1 = 1, no tangents along t: constant in t
+      patch.g[0][1][j] = v / 3;    // P1 along s
+      patch.g[0][3][j] = v;        // T1 along s
+    }
+    PreparedPatch<3> prepared;
+    const bool inside = v > -kGeometryLimitRaw && v < kGeometryLimitRaw;
+    EXPECT_EQ(Prepare(patch, Basis::kHermite, 4, 4, &prepared),
+              inside ? Status::kOk : Status::kGeometryOutOfRange)
+        << v;
+  }
+}
+
 TEST(PrecisionPlanner, RefusesWhatItCannotServe) {
   std::mt19937_64 rng(17);
   RawPatch patch = RandomPatch(rng, Basis::kBezier, 1000);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/protocol/codec.h"
 
+#include "fdsurf/fixed.h"
+
 namespace fdsurf {
 namespace protocol {
 namespace {
@@ -217,7 +219,6 @@ constexpr DecodeResult kOk{ErrorCode::kNone, 0};
 bool BasisValid(uint8_t basis) { return basis < kBasisCount; }
 bool DimsValid(uint8_t dims) { return dims >= 2 && dims <= kMaxAxes; }
 bool LinesValid(uint16_t lines) { return lines == 0 || (lines >= 2 && lines <= kMaxLines); }
-bool GeometryValid(int64_t raw) { return raw > -kGeometryLimitRaw && raw < kGeometryLimitRaw; }
 
 void ReadConfig(Reader* r, MachineConfig* c) {
   c->axes = r->U8(kConfigFieldAxes);
@@ -251,7 +252,7 @@ GeometryFixed ReadGeometry(Reader* r, bool used, uint8_t field) {
     return GeometryFixed::FromRaw(0);
   }
   const int64_t raw = r->SignedVarint(field);
-  r->Check(GeometryValid(raw), field);
+  r->Check(GeometryInRange(raw), field);
   return GeometryFixed::FromRaw(raw);
 }
 

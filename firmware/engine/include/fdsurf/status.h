@@ -5,9 +5,12 @@
 
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
+
 namespace fdsurf {
 
-enum class Status : uint8_t {
+/// [[nodiscard]] (FDSURF_NODISCARD): dropping a Status drops an error.
+enum class FDSURF_NODISCARD Status : uint8_t {
   kOk = 0,
   /// A count, a basis or another argument is outside what the call accepts.
   kInvalidArgument,

@@ -5,13 +5,16 @@
 
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
+
 namespace fdsurf {
 namespace hal {
 
 /// What went wrong, coarsely, so that callers can decide what to do next
 /// (retry, reconnect, give up). The detail for people is the backend's
-/// LastError() string.
-enum class IoStatus : uint8_t {
+/// LastError() string. [[nodiscard]] (FDSURF_NODISCARD): dropping an
+/// IoStatus drops a hardware failure.
+enum class FDSURF_NODISCARD IoStatus : uint8_t {
   kOk = 0,
   /// Nothing (or not everything) happened within the time allowed.
   kTimeout,

@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/protocol/frame.h"
 #include "fdsurf/protocol/messages.h"
 
@@ -100,7 +101,8 @@ constexpr uint8_t kErrorFieldDetail = 1;
 constexpr uint8_t kErrorFieldCount = 2;
 
 /// The outcome of decoding: kNone, or why and where the body was refused.
-struct DecodeResult {
+/// [[nodiscard]] (FDSURF_NODISCARD): a dropped result lets a refused body through.
+struct FDSURF_NODISCARD DecodeResult {
   ErrorCode code;
   uint8_t field;
   constexpr bool ok() const { return code == ErrorCode::kNone; }
