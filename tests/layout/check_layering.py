@@ -16,6 +16,10 @@ import sys
 
 # Box -> the folders whose sources belong to it (relative to the root).
 BOXES = {
+    # The compiler configuration every freestanding box shares (the
+    # nodiscard macro): in the HAL's include folder because fdsurf::hal is
+    # the lowest target, which the core links.
+    "config": ["hal/include/fdsurf/config"],
     "engine": ["firmware/engine"],
     "protocol": ["firmware/protocol"],
     "motion": ["firmware/motion"],
@@ -42,6 +46,7 @@ BOXES = {
 # host library except its end of the link.
 CORE = {"engine", "protocol", "motion", "device", "hal"}
 ALLOWED = {
+    "config": set(),
     "engine": set(),
     "protocol": {"engine"},
     "motion": {"engine", "protocol", "hal"},
@@ -62,6 +67,8 @@ ALLOWED = {
     "sim": CORE | {"hal-sim", "host-link"},
     "tools": set(BOXES),
 }
+for allowed in ALLOWED.values():
+    allowed.add("config")
 
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
 
@@ -86,7 +93,7 @@ def headers(root):
                 base = rel[: rel.index("include") + len("include")]
                 for f in files:
                     name = os.path.relpath(os.path.join(rel, f), base)
-                    found[name] = box
+                    found[name] = box_of(os.path.join(rel, f))
     return found
 
 

@@ -71,7 +71,7 @@ std::optional<GeometryFixed> ToGeometry(double value, const Quantum& quantum) {
   // Checked in double first: a cast of a value beyond int64 is undefined.
   if (!std::isfinite(q) || !(std::fabs(q) < std::ldexp(1.0, 31))) return std::nullopt;
   const auto raw = static_cast<std::int64_t>(std::nearbyint(std::ldexp(q, kGeometryFracBits)));
-  if (!(raw > -kGeometryLimitRaw && raw < kGeometryLimitRaw)) return std::nullopt;
+  if (!GeometryInRange(raw)) return std::nullopt;  // the range the engine itself checks
   return GeometryFixed::FromRaw(raw);
 }
 

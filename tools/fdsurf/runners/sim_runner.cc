@@ -79,7 +79,7 @@ sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
   Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
   constexpr std::uint64_t kTimeLimitUs = 24ull * 3600 * 1'000'000;  // a day of machine time
-  const sim::RunResult run = plotter->Run(
+  sim::RunResult run = plotter->Run(
       link, kTimeLimitUs,
       [&](const sim::RunProgress& p) {
         progress.Show(p.executed, p.total, p.frames_sent, p.time_us * 1e-6);
