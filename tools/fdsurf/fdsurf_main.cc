@@ -22,6 +22,7 @@
 #include "fdsurf/host/reference.h"
 #include "fdsurf/host/toolpath.h"
 #include "fdsurf/host/writers.h"
+#include "fdsurf_version.h"
 #include "stream_command.h"
 
 namespace fdsurf::host {
@@ -408,6 +409,8 @@ int Main(int argc, char** argv) {
       "fdsurf: bicubic patches evaluated by fixed-point forward differences, with a proven "
       "0.51-quantum error bound."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("fdsurf ") + FDSURF_VERSION,
+                       "Print the version and exit");
 
   SampleOptions sample_options;
   CLI::App* sample = app.add_subcommand(
