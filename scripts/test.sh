@@ -13,6 +13,21 @@ bash scripts/setup.sh
 # and runs its image under QEMU or simavr against the host reference.
 ctest --test-dir build --output-on-failure --parallel "$jobs"
 
+echo "== Debian package of the tool: cpack, install, run, remove"
+# CI runs as root (README). The -dev package is built beside it and tested
+# through the install tests (Package.*).
+(cd build && cpack -G DEB >/dev/null)
+version=$(sed -n 's/^CMAKE_PROJECT_VERSION:STATIC=//p' build/CMakeCache.txt)
+deb=$(ls build/fdsurf_"$version"_*.deb)
+dpkg -i "$deb" >/dev/null
+installed=$(/usr/bin/fdsurf --version)
+dpkg -r fdsurf >/dev/null
+if [ "$installed" != "fdsurf $version" ]; then
+  echo "installed /usr/bin/fdsurf --version printed '$installed', expected 'fdsurf $version'" >&2
+  exit 1
+fi
+echo "$deb: /usr/bin/fdsurf --version: $installed"
+
 echo "== build with -fsanitize=address,undefined and test"
 FDSURF_BUILD_DIR=build-sanitize FDSURF_BUILD_TYPE=Debug \
   FDSURF_CMAKE_ARGS="-DFDSURF_SANITIZE=ON -DFDSURF_BUILD_BENCH=OFF" bash scripts/setup.sh

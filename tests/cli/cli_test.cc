@@ -159,6 +159,13 @@ TEST_F(Cli, HelpOnTheToolAndEachCommand) {
   EXPECT_NE(Run("sample --help").out.find("--engine"), std::string::npos);
 }
 
+TEST_F(Cli, VersionIsTheProjectVersion) {
+  const RunResult r = Run("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out, std::string("fdsurf ") + FDSURF_VERSION + "\n");
+  EXPECT_EQ(r.err, "");
+}
+
 TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
   ExpectRefused("sample /nonexistent.bpt --grid 4", "/nonexistent.bpt: cannot open");
   ExpectRefused("sample '" + kTeapot + "' --grid 0", "--grid: '0' is out of range");

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "construct_commands.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf_version.h"
 #include "stream_command.h"
 
 namespace fdsurf::host {
@@ -21,6 +22,8 @@ int Main(int argc, char** argv) {
       "fdsurf: bicubic patches evaluated by fixed-point forward differences, with a proven "
       "0.51-quantum error bound."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("fdsurf ") + FDSURF_VERSION,
+                       "Print the version and exit");
 
   GridOptions sample_options;
   CLI::App* sample = app.add_subcommand(
