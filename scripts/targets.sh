@@ -6,4 +6,4 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ctest --test-dir build -L targets --output-on-failure --parallel "$(nproc)"
-python3 targets/tools/report.py build
+python3 targets/tools/target_report.py build

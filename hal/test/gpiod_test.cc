@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fake_gpiod.h"
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/gpiod_outputs.h"
 
 namespace fdsurf::hal {
@@ -47,7 +48,7 @@ class GpiodTest : public ::testing::Test {
     return status;
   }
 
-  int Value(unsigned offset) const { return chip_->lines[offset].value; }
+  FDSURF_NODISCARD int Value(unsigned offset) const { return chip_->lines[offset].value; }
 
   FakeGpio fake_;
   testing::FakeGpioChip* chip_;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/device/device.h"
 
 namespace fdsurf::sim {
@@ -17,9 +18,9 @@ class DeviceRunner {
   virtual hal::IoStatus Service(hal::Transport& transport) = 0;
   virtual void Fill() = 0;
   virtual hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) = 0;
-  virtual const protocol::DeviceLinkStats& link_stats() const = 0;
-  virtual const protocol::FrameDecoderStats& frame_stats() const = 0;
-  virtual std::uint32_t executed() const = 0;
+  FDSURF_NODISCARD virtual const protocol::DeviceLinkStats& link_stats() const = 0;
+  FDSURF_NODISCARD virtual const protocol::FrameDecoderStats& frame_stats() const = 0;
+  FDSURF_NODISCARD virtual std::uint32_t executed() const = 0;
 };
 
 }  // namespace internal
@@ -36,9 +37,13 @@ class AxesRunner final : public internal::DeviceRunner {
   hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) override {
     return device_.Tick(steppers, pen);
   }
-  const protocol::DeviceLinkStats& link_stats() const override { return device_.link_stats(); }
-  const protocol::FrameDecoderStats& frame_stats() const override { return device_.frame_stats(); }
-  std::uint32_t executed() const override { return device_.executed(); }
+  FDSURF_NODISCARD const protocol::DeviceLinkStats& link_stats() const override {
+    return device_.link_stats();
+  }
+  FDSURF_NODISCARD const protocol::FrameDecoderStats& frame_stats() const override {
+    return device_.frame_stats();
+  }
+  FDSURF_NODISCARD std::uint32_t executed() const override { return device_.executed(); }
 
  private:
   device::Device<kAxes, 8, 1024> device_;
@@ -54,7 +59,7 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
   ~FaultyTransport() = default;
   FaultyTransport(const FaultyTransport&) = delete;
   FaultyTransport& operator=(const FaultyTransport&) = delete;
-  const FaultStats& stats() const { return faults_.stats(); }
+  FDSURF_NODISCARD const FaultStats& stats() const { return faults_.stats(); }
 
  private:
   hal::IoStatus DoWrite(const std::uint8_t* data, std::size_t size,
@@ -71,7 +76,7 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
   hal::IoStatus DoReconnect(std::uint32_t timeout_ms) override {
     return inner_.Reconnect(timeout_ms);
   }
-  const char* DoLastError() const override { return inner_.LastError(); }
+  FDSURF_NODISCARD const char* DoLastError() const override { return inner_.LastError(); }
 
   hal::Transport& inner_;
   FaultLink faults_;
@@ -136,7 +141,7 @@ class HostSide {
     if (!down_ && now >= next_poll_) Send(link, now);
   }
 
-  const FaultStats& fault_stats() const { return to_device_.stats(); }
+  FDSURF_NODISCARD const FaultStats& fault_stats() const { return to_device_.stats(); }
 
  private:
   // The host's PC polls its port about every millisecond.

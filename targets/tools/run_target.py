@@ -10,7 +10,7 @@
    describe the target and are left out of the comparison).
 4. Each "bench" line is paired with its two marks; the cost per point and the
    sizes (text/data/bss of each size image minus the baseline) go to
-   DIR/results/bench.tsv and DIR/results/sizes.tsv for targets/tools/report.py.
+   DIR/results/bench.tsv and DIR/results/sizes.tsv for targets/tools/target_report.py.
 
 Usage: run_target.py --target T --dir BUILD_DIR --host REF --plugin SO --simavr EXE
 """

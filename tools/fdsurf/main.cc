@@ -17,74 +17,69 @@
 namespace fdsurf::host {
 namespace {
 
-int Main(int argc, char** argv) {
-  CLI::App app{
-      "fdsurf: bicubic patches evaluated by fixed-point forward differences, with a proven "
-      "0.51-quantum error bound."};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("fdsurf ") + FDSURF_VERSION,
-                       "Print the version and exit");
-
+// Every command's options and its CLI11 subcommand.
+struct Commands {
   GridOptions sample_options;
-  CLI::App* sample = app.add_subcommand(
+  GridOptions check_options;
+  PlotOptions plot_options;
+  PlotOptions render_options;
+  StreamOptions stream_options;
+  JoinsOptions joins_options;
+  CLI::App* sample = nullptr;
+  CLI::App* check = nullptr;
+  CLI::App* plot = nullptr;
+  CLI::App* render = nullptr;
+  CLI::App* stream = nullptr;
+  CLI::App* joins = nullptr;
+};
+
+void AddCommands(CLI::App* app, Commands* c) {
+  c->sample = app->add_subcommand(
       "sample",
       "Print every grid point of every patch as CSV: patch,i,j,x,y,z (s = i/N, t = j/M).");
-  AddGridOptions(sample, &sample_options);
-  sample
-      ->add_option("--engine", sample_options.engine,
+  AddGridOptions(c->sample, &c->sample_options);
+  c->sample
+      ->add_option("--engine", c->sample_options.engine,
                    "fixed: forward differences, exact multiples of Q; double: the reference")
       ->check(CLI::IsMember({"fixed", "double"}))
       ->capture_default_str();
-
-  GridOptions check_options;
-  CLI::App* check = app.add_subcommand(
+  c->check = app->add_subcommand(
       "check", "Compare the fixed engine with the double reference on every grid point.");
-  AddGridOptions(check, &check_options);
-
-  PlotOptions plot_options;
-  CLI::App* plot = app.add_subcommand(
+  AddGridOptions(c->check, &c->check_options);
+  c->plot = app->add_subcommand(
       "plot",
       "Draw the patches as a wireframe of isolines for a plotter or CNC: SVG, G-code, HPGL.");
-  AddPlotOptions(plot, &plot_options, false);
-  PlotOptions render_options;
-  CLI::App* render = app.add_subcommand("render", "Draw the patches' isolines as a PNG picture.");
-  AddPlotOptions(render, &render_options, true);
-
-  StreamOptions stream_options;
-  CLI::App* stream = app.add_subcommand(
+  AddPlotOptions(c->plot, &c->plot_options, false);
+  c->render = app->add_subcommand("render", "Draw the patches' isolines as a PNG picture.");
+  AddPlotOptions(c->render, &c->render_options, true);
+  c->stream = app->add_subcommand(
       "stream",
       "Stream the patches to a plotter (default: the simulated one), which evaluates them by "
       "forward differences and draws them; report what it drew.");
-  AddStreamOptions(stream, &stream_options);
-
-  JoinsOptions joins_options;
-  CLI::App* joins = app.add_subcommand(
+  AddStreamOptions(c->stream, &c->stream_options);
+  c->joins = app->add_subcommand(
       "joins", "Report for every shared edge of the patches whether the join is C0, G1 or C1.");
-  AddJoinsOptions(joins, &joins_options);
+  AddJoinsOptions(c->joins, &c->joins_options);
+}
 
-  // CLI11 would only say "a subcommand is required" for a mistyped command.
-  const std::string first = argc > 1 ? argv[1] : "";
-  if (argc > 1 && argv[1][0] != '-' && first != "sample" && first != "check" && first != "plot" &&
-      first != "render" && first != "stream" && first != "joins") {
-    std::fprintf(
-        stderr,
-        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream or "
-        "joins)\n",
-        argv[1]);
-    return 2;
-  }
+// CLI11 would only say "a subcommand is required" for a mistyped command.
+bool IsUnknownCommand(int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return false;
+  const std::string first = argv[1];
+  return first != "sample" && first != "check" && first != "plot" && first != "render" &&
+         first != "stream" && first != "joins";
+}
+
+// Runs the parsed command; the library's errors become messages and exit
+// codes (2 bad input or output, 3 the engine refused).
+int RunParsed(const Commands& c) {
   try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  try {
-    if (sample->parsed()) return RunSample(sample_options);
-    if (check->parsed()) return RunCheck(check_options);
-    if (plot->parsed()) return RunPlot(plot_options, false);
-    if (render->parsed()) return RunPlot(render_options, true);
-    if (stream->parsed()) return RunStream(stream_options);
-    if (joins->parsed()) return RunJoins(joins_options);
+    if (c.sample->parsed()) return RunSample(c.sample_options);
+    if (c.check->parsed()) return RunCheck(c.check_options);
+    if (c.plot->parsed()) return RunPlot(c.plot_options, false);
+    if (c.render->parsed()) return RunPlot(c.render_options, true);
+    if (c.stream->parsed()) return RunStream(c.stream_options);
+    if (c.joins->parsed()) return RunJoins(c.joins_options);
   } catch (const OptionError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.MessageFor(FlagFor(e.field())).c_str());
     return 2;
@@ -99,6 +94,31 @@ int Main(int argc, char** argv) {
     return 3;
   }
   return 1;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{
+      "fdsurf: bicubic patches evaluated by fixed-point forward differences, with a proven "
+      "0.51-quantum error bound."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("fdsurf ") + FDSURF_VERSION,
+                       "Print the version and exit");
+  Commands commands;
+  AddCommands(&app, &commands);
+  if (IsUnknownCommand(argc, argv)) {
+    std::fprintf(
+        stderr,
+        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream or "
+        "joins)\n",
+        argv[1]);
+    return 2;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  return RunParsed(commands);
 }
 
 }  // namespace

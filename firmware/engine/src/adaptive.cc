@@ -38,20 +38,11 @@ int64_t RoundedQuotient(const internal::WideInt<4>& x, uint32_t a, uint32_t b) {
   return x.IsNegative() ? -value : value;
 }
 
-}  // namespace
-
+// Per axis: |a|, |b|, |c|, |d| in 2^-16 quanta. kGeometryOutOfRange when a
+// coefficient is outside the geometry range, or the curve could leave int32
+// (|x(t)| ≤ Σ|coefficients|, plus the rounding half).
 template <int kDims>
-Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
-                            PreparedAdaptiveCurve<kDims>* out) {
-  static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
-  const int64_t budget16 =
-      static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
-      (int64_t{1} << 15) - kPreStepAllowance16;
-  if (budget16 <= 0) return Status::kToleranceUnreachable;
-  const bool step_exact = settings.mode == AdaptiveMode::kStepExact;
-
-  // Per axis: |a|, |b|, |c|, |d|, in 2^-16 quanta.
-  uint64_t m[kDims][4];
+Status CoefficientMagnitudes(const PowerCurve1 (&curve)[kDims], uint64_t (&m)[kDims][4]) {
   for (int c = 0; c < kDims; ++c) {
     uint64_t sum = 0;
     for (int k = 0; k < 4; ++k) {
@@ -59,18 +50,20 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
       m[c][k] = Magnitude(curve[c].c[k]);
       sum += m[c][k];
     }
-    // |x(t)| ≤ Σ|coefficients|; with the rounding half it must stay in int32.
     if (sum + (uint64_t{1} << 15) >= static_cast<uint64_t>(kGeometryLimitRaw)) {
       return Status::kGeometryOutOfRange;
     }
   }
+  return Status::kOk;
+}
 
-  // The finest level L: the smallest at which every step of 2^-L passes.
-  // In units of 2^-(16+3L) quanta, |Δ²| ≤ (6|a| + 2|b|)·2^L + 6|a| and
-  // |Δ² − Δ³| is smaller; the chord limit is 8·budget = budget16·2^(3+3L).
-  // In step-exact mode also |Δ¹| ≤ (3|a| + 2|b| + |c|)·2^(2L) ≤ 2^(16+3L).
-  int level = 0;
-  for (;; ++level) {
+// The finest level L: the smallest at which every step of 2^-L passes.
+// In units of 2^-(16+3L) quanta, |Δ²| ≤ (6|a| + 2|b|)·2^L + 6|a| and
+// |Δ² − Δ³| is smaller; the chord limit is 8·budget = budget16·2^(3+3L).
+// In step-exact mode also |Δ¹| ≤ (3|a| + 2|b| + |c|)·2^(2L) ≤ 2^(16+3L).
+template <int kDims>
+Status FinestLevel(const uint64_t (&m)[kDims][4], int64_t budget16, bool step_exact, int* out) {
+  for (int level = 0;; ++level) {
     if (level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
     bool fits = true;
     const Wide chord_limit =
@@ -84,13 +77,20 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
         fits = !(Wide::PowerOfTwo(kCoefficientFracBits + level) < first);
       }
     }
-    if (fits) break;
+    if (fits) {
+      *out = level;
+      return Status::kOk;
+    }
   }
-  const int frac_bits = kCoefficientFracBits + 3 * level;
+}
 
-  // Every value the stepper forms (differences at any level up to step 1,
-  // the doubling and halving intermediates, the rounding half) is below
-  // 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F.
+// The accumulator: every value the stepper forms (differences at any level
+// up to step 1, the doubling and halving intermediates, the rounding half)
+// is below 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F; 64 bits when that
+// fits in 62 (and F ≤ 62), else 128 when it fits in 126.
+template <int kDims>
+Status AccumulatorBits(const uint64_t (&m)[kDims][4], int level, int frac_bits,
+                       const AdaptiveSettings& settings, int* out) {
   Wide largest;
   for (int c = 0; c < kDims; ++c) {
     const Wide bound = Wide::FromUint64(8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3]))
@@ -98,14 +98,36 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
                        Wide::PowerOfTwo(frac_bits);
     if (largest < bound) largest = bound;
   }
-  int acc_bits = 0;
   if (frac_bits <= 62 && largest < Wide::PowerOfTwo(62) && settings.max_acc_bits >= 64) {
-    acc_bits = 64;
+    *out = 64;
   } else if (largest < Wide::PowerOfTwo(126) && settings.max_acc_bits >= 128) {
-    acc_bits = 128;
+    *out = 128;
   } else {
     return Status::kPrecisionUnreachable;
   }
+  return Status::kOk;
+}
+
+}  // namespace
+
+template <int kDims>
+Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
+                            PreparedAdaptiveCurve<kDims>* out) {
+  static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
+  const int64_t budget16 =
+      static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
+      (int64_t{1} << 15) - kPreStepAllowance16;
+  if (budget16 <= 0) return Status::kToleranceUnreachable;
+  uint64_t m[kDims][4];
+  Status status = CoefficientMagnitudes(curve, m);
+  if (status != Status::kOk) return status;
+  int level = 0;
+  status = FinestLevel(m, budget16, settings.mode == AdaptiveMode::kStepExact, &level);
+  if (status != Status::kOk) return status;
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+  int acc_bits = 0;
+  status = AccumulatorBits(m, level, frac_bits, settings, &acc_bits);
+  if (status != Status::kOk) return status;
 
   PreparedAdaptiveCurve<kDims> result;
   result.format.acc_bits = static_cast<uint8_t>(acc_bits);
@@ -124,8 +146,8 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
     result.d[c][2] = internal::ToInt128(a.MulInt64(6) + b.ShiftedLeft(level + 1));
     result.d[c][3] = internal::ToInt128(a.MulInt64(6));
   }
-  // Values never exceed `largest`, so a larger limit would act the same;
-  // clamping keeps it representable in the accumulator.
+  // Values never exceed the accumulator bound, so a larger limit would act
+  // the same; clamping keeps it representable in the accumulator.
   Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
   const Wide clamp = Wide::PowerOfTwo(acc_bits - 2);
   if (clamp < chord_limit) chord_limit = clamp;

@@ -310,8 +310,13 @@ bool PathGenerator<kDims>::NextPoint(int32_t (&point)[kDims]) {
   return cursor_wide_ ? cursor128_.Next(point, &position) : cursor64_.Next(point, &position);
 }
 
+// One state machine over the stages of a command (stepping, next line,
+// travel to the line's start, after travel, finish): longer than the
+// project's 80 lines on purpose, since the stages hand over to each other
+// through `stage_` and read best side by side, and the per-point case
+// (kStepping) runs on every unit move without a further call.
 template <int kDims>
-bool PathGenerator<kDims>::Next(uint8_t* entry) {
+bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-function-size)
   for (;;) {
     if (pending_head_ < pending_count_) {
       *entry = pending_[pending_head_++];

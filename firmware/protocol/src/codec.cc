@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/protocol/codec.h"
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/fixed.h"
 
 namespace fdsurf {
@@ -39,7 +40,7 @@ class BodyWriter {
     const uint64_t magnitude_twice = static_cast<uint64_t>(value) << 1;
     PutVarint(value < 0 ? ~magnitude_twice : magnitude_twice);
   }
-  size_t Size() const { return size_ <= capacity_ ? size_ : 0; }
+  FDSURF_NODISCARD size_t Size() const { return size_ <= capacity_ ? size_ : 0; }
 
  private:
   uint8_t* out_;
@@ -119,7 +120,7 @@ class Reader {
  public:
   explicit Reader(const Frame& frame) : data_(frame.body), size_(frame.body_size) {}
 
-  bool ok() const { return result_.ok(); }
+  FDSURF_NODISCARD bool ok() const { return result_.ok(); }
   DecodeResult result() const { return result_; }
 
   uint8_t U8(uint8_t field) {
@@ -449,7 +450,7 @@ DecodeResult DecodeCommand(const Frame& frame, Command* out) {
   return reader.result();
 }
 
-DecodeResult ValidateCommand(const Command& command) {
+DecodeResult ValidateFields(const Command& command) {
   if (!IsSequenced(command.type)) {
     return DecodeResult{ErrorCode::kUnknownType, 0};
   }

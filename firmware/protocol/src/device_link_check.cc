@@ -2,6 +2,7 @@
 // Instantiates DeviceLink under the core's freestanding flags with a minimal
 // sink, so the header-only link is compiled (and held to the same rules) in
 // every build of the core.
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/protocol/device_link.h"
 
 namespace fdsurf {
@@ -10,10 +11,10 @@ namespace {
 
 struct NullSink {
   ErrorCode Accept(const Command& /*command*/, uint8_t* /*detail*/) { return ErrorCode::kNone; }
-  uint8_t Credits() const { return 1; }
-  uint8_t QueueCapacity() const { return 1; }
-  uint32_t TickHz() const { return 1; }
-  uint8_t MaxAxes() const { return 2; }
+  FDSURF_NODISCARD uint8_t Credits() const { return 1; }
+  FDSURF_NODISCARD uint8_t QueueCapacity() const { return 1; }
+  FDSURF_NODISCARD uint32_t TickHz() const { return 1; }
+  FDSURF_NODISCARD uint8_t MaxAxes() const { return 2; }
   void FillStatus(StatusReport* /*report*/) const {}
   void Stop() {}
   void Reset() {}

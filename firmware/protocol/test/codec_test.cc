@@ -131,7 +131,7 @@ void ExpectRoundTrip(const Command& command) {
   EXPECT_EQ(decoded.type, command.type);
   EXPECT_EQ(decoded.seq, command.seq);
   EXPECT_EQ(CommandBody(decoded), CommandBody(command));
-  EXPECT_TRUE(ValidateCommand(command).ok());
+  EXPECT_TRUE(ValidateFields(command).ok());
 }
 
 TEST(Codec, CommandRoundTrips) {
@@ -202,7 +202,7 @@ void ExpectRefused(const Command& command, ErrorCode code, uint8_t field) {
   const DecodeResult result = DecodeOf(command);
   EXPECT_EQ(result.code, code) << ErrorName(result.code);
   EXPECT_EQ(result.field, field);
-  const DecodeResult validated = ValidateCommand(command);
+  const DecodeResult validated = ValidateFields(command);
   EXPECT_EQ(validated.code, code);
   EXPECT_EQ(validated.field, field);
 }

@@ -108,7 +108,7 @@ HostLink::HostLink(HostLinkOptions options) : options_(options) {
 }
 
 protocol::DecodeResult HostLink::Enqueue(const protocol::Command& command, std::string label) {
-  const protocol::DecodeResult result = protocol::ValidateCommand(command);
+  const protocol::DecodeResult result = protocol::ValidateFields(command);
   if (!result.ok()) {
     return result;
   }

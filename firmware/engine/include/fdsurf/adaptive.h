@@ -27,6 +27,7 @@
 #include <stdint.h>
 
 #include "fdsurf/basis.h"
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/int128.h"
 #include "fdsurf/status.h"
@@ -118,9 +119,9 @@ class IsolineWalker {
   static Status Create(const PatchGeometry1 (&geometry)[kDims], Basis basis, IsolineFamily family,
                        uint16_t lines, IsolineWalker* out);
 
-  uint16_t lines() const { return lines_; }
+  FDSURF_NODISCARD uint16_t lines() const { return lines_; }
   /// How many lines Next() has produced.
-  uint16_t produced() const { return produced_; }
+  FDSURF_NODISCARD uint16_t produced() const { return produced_; }
 
   /// The power coefficients (in t for s-lines, in s for t-lines) of the next
   /// line, then one row-add step across the patch. Returns false after the

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <stdint.h>
+#include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf {
 
@@ -40,7 +41,7 @@ class Fixed {
 
   constexpr Fixed() : raw_(0) {}
   static constexpr Fixed FromRaw(Rep raw) { return Fixed(raw); }
-  constexpr Rep Raw() const { return raw_; }
+  FDSURF_NODISCARD constexpr Rep Raw() const { return raw_; }
 
  private:
   constexpr explicit Fixed(Rep raw) : raw_(raw) {}

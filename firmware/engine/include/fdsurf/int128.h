@@ -8,6 +8,7 @@
 #pragma once
 
 #include <stdint.h>
+#include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf {
 
@@ -38,7 +39,7 @@ struct Int128 {
     return zero;
   }
 
-  bool IsNegative() const { return (hi >> 63) != 0; }
+  FDSURF_NODISCARD bool IsNegative() const { return (hi >> 63) != 0; }
 
   friend Int128 operator+(Int128 a, const Int128& b) { return a += b; }
   friend Int128 operator-(Int128 a, const Int128& b) { return a -= b; }

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/io_status.h"
 
 namespace fdsurf {
@@ -23,7 +24,7 @@ class StepDirOutputs {
   StepDirOutputs& operator=(const StepDirOutputs&) = delete;
 
   /// The number of axes driven: 2 (X, Y) or 3 (X, Y, Z).
-  uint8_t axes() const { return axes_; }
+  FDSURF_NODISCARD uint8_t axes() const { return axes_; }
 
   /// Energises (true) or releases (false) the motors. Drivers without an
   /// enable line accept this and do nothing.
@@ -51,20 +52,20 @@ class StepDirOutputs {
   IoStatus Step(uint8_t axis_mask) { return DoStep(axis_mask); }
 
   /// The detail of the last failed call ("" if none), naming the line.
-  const char* LastError() const { return DoLastError(); }
+  FDSURF_NODISCARD const char* LastError() const { return DoLastError(); }
 
  protected:
   explicit StepDirOutputs(uint8_t axes) : axes_(axes) {}
   ~StepDirOutputs() = default;
 
   /// The mask of the valid axis bits, (1 << axes()) - 1.
-  uint8_t axis_bits() const { return static_cast<uint8_t>((1u << axes_) - 1u); }
+  FDSURF_NODISCARD uint8_t axis_bits() const { return static_cast<uint8_t>((1u << axes_) - 1u); }
 
  private:
   virtual IoStatus DoSetEnabled(bool enabled) = 0;
   virtual IoStatus DoSetDirections(uint8_t negative_mask) = 0;
   virtual IoStatus DoStep(uint8_t axis_mask) = 0;
-  virtual const char* DoLastError() const = 0;
+  FDSURF_NODISCARD virtual const char* DoLastError() const = 0;
 
   uint8_t axes_;
 };
@@ -83,7 +84,7 @@ class PenOutput {
   IoStatus SetPen(bool down) { return DoSetPen(down); }
 
   /// The detail of the last failed call ("" if none).
-  const char* LastError() const { return DoLastError(); }
+  FDSURF_NODISCARD const char* LastError() const { return DoLastError(); }
 
  protected:
   PenOutput() = default;
@@ -91,7 +92,7 @@ class PenOutput {
 
  private:
   virtual IoStatus DoSetPen(bool down) = 0;
-  virtual const char* DoLastError() const = 0;
+  FDSURF_NODISCARD virtual const char* DoLastError() const = 0;
 };
 
 }  // namespace hal

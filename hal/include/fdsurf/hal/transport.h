@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/io_status.h"
 
 namespace fdsurf {
@@ -65,7 +66,7 @@ class Transport {
   /// The human-readable detail of the last failed call, naming the device
   /// (e.g. "usb 1209:0001: disconnected (LIBUSB_ERROR_NO_DEVICE)"), or ""
   /// if no call has failed yet. Valid until the next call on this object.
-  const char* LastError() const { return DoLastError(); }
+  FDSURF_NODISCARD const char* LastError() const { return DoLastError(); }
 
  protected:
   Transport() = default;
@@ -76,7 +77,7 @@ class Transport {
   virtual IoStatus DoRead(uint8_t* data, size_t capacity, size_t* received,
                           uint32_t timeout_ms) = 0;
   virtual IoStatus DoReconnect(uint32_t timeout_ms) = 0;
-  virtual const char* DoLastError() const = 0;
+  FDSURF_NODISCARD virtual const char* DoLastError() const = 0;
 };
 
 }  // namespace hal

@@ -10,6 +10,7 @@
 #include <optional>
 #include <random>
 #include <vector>
+#include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf::sim {
 
@@ -61,7 +62,7 @@ class FaultLink {
 
   /// Changes the rates from now on (e.g. a "disconnect": drop = 1).
   void set_rates(FaultRates rates) { rates_ = rates; }
-  const FaultStats& stats() const { return stats_; }
+  FDSURF_NODISCARD const FaultStats& stats() const { return stats_; }
 
  private:
   void Frame(std::vector<uint8_t>* out);  // handles partial_ + its delimiter
@@ -85,9 +86,9 @@ class Pipe {
   /// Reads up to `capacity` bytes that have arrived by `now_us`.
   size_t Read(uint8_t* data, size_t capacity, uint64_t now_us);
   /// Bytes written and not yet read (arrived or not).
-  size_t pending() const { return bytes_.size(); }
+  FDSURF_NODISCARD size_t pending() const { return bytes_.size(); }
   /// When the next unread byte arrives, if any.
-  std::optional<uint64_t> next_arrival_us() const;
+  FDSURF_NODISCARD std::optional<uint64_t> next_arrival_us() const;
 
  private:
   uint64_t latency_us_;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/sim.h"
 #include "fdsurf/host/link.h"
 #include "fdsurf/protocol/device_link.h"
@@ -84,14 +85,16 @@ class SimulatedPlotter {
   /// time); the host calls Resume() when it reconnects.
   void ScheduleUnplug(std::uint64_t at_us, std::uint64_t back_us);
 
-  const PlotterOptions& options() const { return options_; }
-  const std::vector<hal::StepDirEvent>& step_events() const { return steps_.events(); }
-  const std::vector<hal::PenEvent>& pen_events() const { return pen_.events(); }
+  FDSURF_NODISCARD const PlotterOptions& options() const { return options_; }
+  FDSURF_NODISCARD const std::vector<hal::StepDirEvent>& step_events() const {
+    return steps_.events();
+  }
+  FDSURF_NODISCARD const std::vector<hal::PenEvent>& pen_events() const { return pen_.events(); }
   /// The machine's position now (steps), from the recorded pulses.
-  std::array<std::int64_t, 3> position() const;
+  FDSURF_NODISCARD std::array<std::int64_t, 3> position() const;
 
   /// The pen-down strokes, rebuilt from the recorded step and pen events.
-  std::vector<DrawnPath> DrawnPaths() const;
+  FDSURF_NODISCARD std::vector<DrawnPath> DrawnPaths() const;
 
  private:
   class FaultyTransport;

@@ -22,6 +22,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/outputs.h"
 #include "fdsurf/hal/transport.h"
 #include "fdsurf/motion/motion_loop.h"
@@ -141,11 +142,13 @@ class Device {
 
   // --- State --------------------------------------------------------------
 
-  const motion::MotionLoop& motion() const { return motion_; }
-  const protocol::DeviceLinkStats& link_stats() const { return link_.stats(); }
-  const protocol::FrameDecoderStats& frame_stats() const { return link_.frame_stats(); }
-  uint32_t executed() const { return executed_; }
-  bool Idle() const { return queued_ == 0 && generator_.Idle() && motion_.Idle(); }
+  FDSURF_NODISCARD const motion::MotionLoop& motion() const { return motion_; }
+  FDSURF_NODISCARD const protocol::DeviceLinkStats& link_stats() const { return link_.stats(); }
+  FDSURF_NODISCARD const protocol::FrameDecoderStats& frame_stats() const {
+    return link_.frame_stats();
+  }
+  FDSURF_NODISCARD uint32_t executed() const { return executed_; }
+  FDSURF_NODISCARD bool Idle() const { return queued_ == 0 && generator_.Idle() && motion_.Idle(); }
 
   // --- The protocol sink (fdsurf/protocol/device_link.h) ------------------
 
@@ -176,10 +179,12 @@ class Device {
     ++queued_;
     return protocol::ErrorCode::kNone;
   }
-  uint8_t Credits() const { return static_cast<uint8_t>(kQueueCapacity - queued_); }
-  uint8_t QueueCapacity() const { return static_cast<uint8_t>(kQueueCapacity); }
-  uint32_t TickHz() const { return tick_hz_; }
-  uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
+  FDSURF_NODISCARD uint8_t Credits() const {
+    return static_cast<uint8_t>(kQueueCapacity - queued_);
+  }
+  FDSURF_NODISCARD uint8_t QueueCapacity() const { return static_cast<uint8_t>(kQueueCapacity); }
+  FDSURF_NODISCARD uint32_t TickHz() const { return tick_hz_; }
+  FDSURF_NODISCARD uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
 
   void FillStatus(protocol::StatusReport* report) const {
     if (fault_) {
@@ -225,7 +230,7 @@ class Device {
   }
 
  private:
-  motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
+  FDSURF_NODISCARD motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
     return motion::MotionLimits{tick_hz_, config.max_rate, config.accel, config.pen_delay_ms};
   }
 

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/int128.h"
 
 namespace fdsurf {
@@ -51,16 +52,16 @@ class WideInt {
     return w;
   }
 
-  bool IsNegative() const { return (limb_[kLimbs - 1] >> 31) != 0; }
+  FDSURF_NODISCARD bool IsNegative() const { return (limb_[kLimbs - 1] >> 31) != 0; }
 
-  bool IsZero() const {
+  FDSURF_NODISCARD bool IsZero() const {
     for (int i = 0; i < kLimbs; ++i) {
       if (limb_[i] != 0) return false;
     }
     return true;
   }
 
-  uint32_t limb(int i) const { return limb_[i]; }
+  FDSURF_NODISCARD uint32_t limb(int i) const { return limb_[i]; }
 
   WideInt& operator+=(const WideInt& other) {
     uint32_t carry = 0;
@@ -106,10 +107,10 @@ class WideInt {
     return negative ? -product : product;
   }
 
-  WideInt Abs() const { return IsNegative() ? -*this : *this; }
+  FDSURF_NODISCARD WideInt Abs() const { return IsNegative() ? -*this : *this; }
 
   /// Logical shift left by 0 <= bits < kBits.
-  WideInt ShiftedLeft(int bits) const {
+  FDSURF_NODISCARD WideInt ShiftedLeft(int bits) const {
     WideInt result;
     const int whole = bits / 32;
     const int part = bits % 32;
@@ -122,7 +123,7 @@ class WideInt {
   }
 
   /// Number of significant bits of the magnitude (0 for zero).
-  int MagnitudeBits() const {
+  FDSURF_NODISCARD int MagnitudeBits() const {
     const WideInt m = Abs();
     for (int i = kLimbs - 1; i >= 0; --i) {
       if (m.limb_[i] != 0) {
@@ -136,7 +137,7 @@ class WideInt {
 
   /// The product with a 64-bit integer: cheaper than a full WideInt product,
   /// and what most of the set-up's matrix products need. Truncating.
-  WideInt MulInt64(int64_t factor) const {
+  FDSURF_NODISCARD WideInt MulInt64(int64_t factor) const {
     // In two's complement the low kBits of x·y are those of x·(y mod 2^64),
     // less x·2^64 when y is negative.
     const uint64_t y = static_cast<uint64_t>(factor);
@@ -158,7 +159,7 @@ class WideInt {
 
   /// The same value in another width (sign-extended or truncated).
   template <int kOtherLimbs>
-  WideInt<kOtherLimbs> Resized() const {
+  FDSURF_NODISCARD WideInt<kOtherLimbs> Resized() const {
     WideInt<kOtherLimbs> result;
     const uint32_t fill = IsNegative() ? 0xFFFFFFFFu : 0u;
     for (int i = 0; i < kOtherLimbs; ++i) result.set_limb(i, i < kLimbs ? limb_[i] : fill);

@@ -27,6 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/motion/entry.h"
 
 namespace fdsurf {
@@ -77,15 +78,15 @@ class MotionLoop {
 
   /// Sets the limits used from now on; call only when AtRest() and Empty().
   void Configure(const TickLimits& limits) { limits_ = limits; }
-  const TickLimits& limits() const { return limits_; }
+  FDSURF_NODISCARD const TickLimits& limits() const { return limits_; }
 
   /// Appends an entry; false (and nothing changes) when the buffer is full.
   bool Push(uint8_t entry);
-  bool Full() const { return count_ == capacity_; }
-  bool Empty() const { return count_ == 0; }
-  uint16_t Count() const { return count_; }
+  FDSURF_NODISCARD bool Full() const { return count_ == capacity_; }
+  FDSURF_NODISCARD bool Empty() const { return count_ == 0; }
+  FDSURF_NODISCARD uint16_t Count() const { return count_; }
   /// At rest, not waiting for the pen, nothing buffered.
-  bool Idle() const { return count_ == 0 && speed_ == 0 && pen_wait_ == 0; }
+  FDSURF_NODISCARD bool Idle() const { return count_ == 0 && speed_ == 0 && pen_wait_ == 0; }
 
   /// Advances one tick: updates the speed, executes at most one unit move or
   /// one pen change, and reports what to output.
@@ -94,22 +95,22 @@ class MotionLoop {
   /// Decelerates to rest along the buffered path as fast as the limits
   /// allow, then drops whatever is left. Stopped() tells when that is done.
   void Stop() { stopping_ = true; }
-  bool Stopping() const { return stopping_; }
+  FDSURF_NODISCARD bool Stopping() const { return stopping_; }
 
   /// Forgets the buffer and the motion state (the caller has made sure the
   /// machine is at rest). Position and counters are kept.
   void Clear();
 
-  const int32_t* position() const { return position_; }
+  FDSURF_NODISCARD const int32_t* position() const { return position_; }
   void set_position(const int32_t (&position)[3]);
-  bool pen_down() const { return pen_down_; }
+  FDSURF_NODISCARD bool pen_down() const { return pen_down_; }
   /// Path speed now, 2^-24 steps per tick.
-  uint32_t speed() const { return speed_; }
+  FDSURF_NODISCARD uint32_t speed() const { return speed_; }
   /// Unit moves executed since construction (wraps).
-  uint32_t moves() const { return moves_; }
+  FDSURF_NODISCARD uint32_t moves() const { return moves_; }
 
  private:
-  uint8_t At(uint16_t offset) const { return storage_[(head_ + offset) & mask_]; }
+  FDSURF_NODISCARD uint8_t At(uint16_t offset) const { return storage_[(head_ + offset) & mask_]; }
   void Pop();
   /// Path length from the head to the first pen event, or to the end of the buffer.
   void RecomputeDistance();

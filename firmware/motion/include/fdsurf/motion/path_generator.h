@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "fdsurf/adaptive.h"
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/motion/entry.h"
 #include "fdsurf/protocol/messages.h"
 
@@ -48,7 +49,9 @@ class PathGenerator {
   void Reset(const int32_t* position, bool pen_down);
 
   /// True when no command is being expanded and every entry was handed out.
-  bool Idle() const { return stage_ == Stage::kIdle && pending_head_ >= pending_count_; }
+  FDSURF_NODISCARD bool Idle() const {
+    return stage_ == Stage::kIdle && pending_head_ >= pending_count_;
+  }
 
   /// Starts expanding a validated motion command (patch, curve, move, pen).
   void Start(const protocol::Command& command);
@@ -58,9 +61,9 @@ class PathGenerator {
   /// refuses a line (ValidateCommand rules that out).
   bool Next(uint8_t* entry);
 
-  bool failed() const { return failed_; }
+  FDSURF_NODISCARD bool failed() const { return failed_; }
   Status failure() const { return failure_; }
-  const int32_t* position() const { return position_; }
+  FDSURF_NODISCARD const int32_t* position() const { return position_; }
 
  private:
   enum class Stage : uint8_t {

@@ -105,7 +105,7 @@ constexpr uint8_t kErrorFieldCount = 2;
 struct FDSURF_NODISCARD DecodeResult {
   ErrorCode code;
   uint8_t field;
-  constexpr bool ok() const { return code == ErrorCode::kNone; }
+  FDSURF_NODISCARD constexpr bool ok() const { return code == ErrorCode::kNone; }
 };
 
 /// A decoded device → host message. `seq` is the frame's seq field: the
@@ -155,10 +155,10 @@ size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity);
 /// sequenced type), kBadLength, kBadField. out->type and out->seq are the
 /// frame's. Geometry of unused axes is zeroed.
 DecodeResult DecodeCommand(const Frame& frame, Command* out);
-/// Validates a command struct exactly as DecodeCommand would after a round
+/// Validates the fields of a command struct exactly as DecodeCommand would after a round
 /// trip (the host checks what it sends before it sends it). Uses about 1 KB
 /// of stack (a body buffer and a Command): meant for the host, not a device.
-DecodeResult ValidateCommand(const Command& command);
+DecodeResult ValidateFields(const Command& command);
 /// kHello. A first byte other than kProtocolVersion gives
 /// kUnsupportedVersion (field 0) whatever follows, so later versions may
 /// change the rest of the body; else kBadLength, kBadField (unknown flags).

@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf {
 namespace protocol {
@@ -24,7 +25,7 @@ class Crc32 {
   /// Feeds `size` bytes; `data` may be null when `size` is 0.
   void Update(const uint8_t* data, size_t size);
   /// The CRC of every byte fed so far (does not change the state).
-  constexpr uint32_t Value() const { return state_ ^ 0xFFFFFFFFu; }
+  FDSURF_NODISCARD constexpr uint32_t Value() const { return state_ ^ 0xFFFFFFFFu; }
 
  private:
   uint32_t state_ = 0xFFFFFFFFu;

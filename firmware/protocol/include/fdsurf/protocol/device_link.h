@@ -39,6 +39,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/protocol/codec.h"
 #include "fdsurf/protocol/frame.h"
 #include "fdsurf/protocol/messages.h"
@@ -104,13 +105,13 @@ class DeviceLink {
     return n;
   }
   /// Bytes waiting in the output buffer.
-  size_t OutputPending() const { return out_end_ - out_begin_; }
+  FDSURF_NODISCARD size_t OutputPending() const { return out_end_ - out_begin_; }
 
   /// The sequence number the link expects next.
-  uint16_t next_seq() const { return next_seq_; }
-  const DeviceLinkStats& stats() const { return stats_; }
+  FDSURF_NODISCARD uint16_t next_seq() const { return next_seq_; }
+  FDSURF_NODISCARD const DeviceLinkStats& stats() const { return stats_; }
   /// Frames delivered and dropped by the framing layer (CRC, COBS, length).
-  const FrameDecoderStats& frame_stats() const { return decoder_.stats(); }
+  FDSURF_NODISCARD const FrameDecoderStats& frame_stats() const { return decoder_.stats(); }
 
  private:
   void HandleFrame(const Frame& frame) {

@@ -18,6 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/protocol/crc32.h"
 #include "fdsurf/protocol/messages.h"
 
@@ -117,11 +118,11 @@ class FrameDecoder {
   /// Feeds one byte. Returns true when it completed a valid frame, which
   /// frame() then describes.
   bool OnByte(uint8_t byte);
-  const Frame& frame() const { return frame_; }
+  FDSURF_NODISCARD const Frame& frame() const { return frame_; }
 
   /// Forgets any partly received frame (e.g. after a reconnect). Counters stay.
   void Reset();
-  const FrameDecoderStats& stats() const { return stats_; }
+  FDSURF_NODISCARD const FrameDecoderStats& stats() const { return stats_; }
 
  private:
   bool EndOfFrame();

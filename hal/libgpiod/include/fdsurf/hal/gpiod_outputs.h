@@ -25,6 +25,7 @@
 #include <string>
 #include <string_view>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/hal/outputs.h"
 
@@ -109,7 +110,7 @@ class GpiodOutputs final : public StepDirOutputs, public PenOutput {
   IoStatus DoSetDirections(uint8_t negative_mask) override;
   IoStatus DoStep(uint8_t axis_mask) override;
   IoStatus DoSetPen(bool down) override;
-  const char* DoLastError() const override { return last_error_.c_str(); }
+  FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
 
   IoStatus Set(int index, bool active);
   IoStatus CheckMask(uint8_t mask, const char* what);

@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/hal/transport.h"
 
@@ -38,9 +39,9 @@ struct UsbSelector {
   uint8_t bus = 0;
   std::vector<uint8_t> ports;
 
-  bool by_port() const { return !ports.empty(); }
+  FDSURF_NODISCARD bool by_port() const { return !ports.empty(); }
   /// "1209:0001" or "1-1.4": how every error message names the device.
-  std::string ToString() const;
+  FDSURF_NODISCARD std::string ToString() const;
 };
 
 /// Parses "usb", "usb:VID:PID" or "usb:BUS-PORT[.PORT...]". Returns false with
@@ -88,13 +89,13 @@ class UsbTransport final : public Transport {
   UsbTransport& operator=(const UsbTransport&) = delete;
 
   /// The device opened (valid after Open, kept across reconnects).
-  uint16_t vendor_id() const { return vendor_id_; }
-  uint16_t product_id() const { return product_id_; }
+  FDSURF_NODISCARD uint16_t vendor_id() const { return vendor_id_; }
+  FDSURF_NODISCARD uint16_t product_id() const { return product_id_; }
   /// The serial number string, "" if the device has none.
-  const std::string& serial() const { return serial_; }
+  FDSURF_NODISCARD const std::string& serial() const { return serial_; }
   /// "BUS-PORT.PORT..." of the device as last opened.
-  std::string port_path() const;
-  bool connected() const { return handle_ != nullptr; }
+  FDSURF_NODISCARD std::string port_path() const;
+  FDSURF_NODISCARD bool connected() const { return handle_ != nullptr; }
 
  private:
   enum class Match { kTaken, kSkipped, kFailed };
@@ -104,7 +105,7 @@ class UsbTransport final : public Transport {
   IoStatus DoWrite(const uint8_t* data, size_t size, uint32_t timeout_ms) override;
   IoStatus DoRead(uint8_t* data, size_t capacity, size_t* received, uint32_t timeout_ms) override;
   IoStatus DoReconnect(uint32_t timeout_ms) override;
-  const char* DoLastError() const override { return last_error_.c_str(); }
+  FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
 
   // Enumerates and opens the selected device (or, when `reconnecting`, the
   // same device as before).

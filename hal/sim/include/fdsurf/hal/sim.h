@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/clock.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/hal/outputs.h"
@@ -26,7 +27,7 @@ class SimClock final : public Clock {
  public:
   explicit SimClock(uint64_t start_us = 0) : now_us_(start_us) {}
 
-  uint64_t now_us() const { return now_us_; }
+  FDSURF_NODISCARD uint64_t now_us() const { return now_us_; }
   /// Moves time forward by `us`.
   void Advance(uint64_t us) { now_us_ += us; }
   /// Sets the time; a time earlier than now is ignored (time is monotonic).
@@ -61,13 +62,13 @@ class SimStepDir final : public StepDirOutputs {
   /// kInvalidArgument. The clock must outlive this object.
   SimStepDir(SimClock& clock, uint8_t axes);
 
-  const std::vector<StepDirEvent>& events() const { return events_; }
+  FDSURF_NODISCARD const std::vector<StepDirEvent>& events() const { return events_; }
   void ClearEvents() { events_.clear(); }
   /// Net steps of `axis` so far (+1 per positive step, -1 per negative),
   /// counting steps while disabled too (the events show those).
-  int64_t position(int axis) const { return position_[axis]; }
-  bool enabled() const { return enabled_; }
-  uint8_t negative_mask() const { return negative_mask_; }
+  FDSURF_NODISCARD int64_t position(int axis) const { return position_[axis]; }
+  FDSURF_NODISCARD bool enabled() const { return enabled_; }
+  FDSURF_NODISCARD uint8_t negative_mask() const { return negative_mask_; }
 
   /// Makes the next call fail with `status` (for testing callers' error
   /// paths); LastError() then reads "sim step/dir: injected <status name>".
@@ -77,7 +78,7 @@ class SimStepDir final : public StepDirOutputs {
   IoStatus DoSetEnabled(bool enabled) override;
   IoStatus DoSetDirections(uint8_t negative_mask) override;
   IoStatus DoStep(uint8_t axis_mask) override;
-  const char* DoLastError() const override { return last_error_.c_str(); }
+  FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
   IoStatus Check(uint8_t mask, const char* what);
 
   SimClock& clock_;
@@ -102,15 +103,15 @@ class SimPen final : public PenOutput {
  public:
   explicit SimPen(SimClock& clock) : clock_(clock) {}
 
-  const std::vector<PenEvent>& events() const { return events_; }
+  FDSURF_NODISCARD const std::vector<PenEvent>& events() const { return events_; }
   void ClearEvents() { events_.clear(); }
-  bool down() const { return down_; }
+  FDSURF_NODISCARD bool down() const { return down_; }
   /// Makes the next SetPen() fail with `status`.
   void InjectError(IoStatus status) { injected_ = status; }
 
  private:
   IoStatus DoSetPen(bool down) override;
-  const char* DoLastError() const override { return last_error_.c_str(); }
+  FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
 
   SimClock& clock_;
   std::vector<PenEvent> events_;
@@ -162,8 +163,8 @@ class SimTransportPair {
 
   /// Bytes written towards the device (or host) and not read yet, including
   /// those not yet deliverable.
-  size_t in_flight_to_device() const { return to_device_.in_flight; }
-  size_t in_flight_to_host() const { return to_host_.in_flight; }
+  FDSURF_NODISCARD size_t in_flight_to_device() const { return to_device_.in_flight; }
+  FDSURF_NODISCARD size_t in_flight_to_host() const { return to_host_.in_flight; }
 
  private:
   struct Chunk {
@@ -186,7 +187,7 @@ class SimTransportPair {
     IoStatus DoWrite(const uint8_t* data, size_t size, uint32_t timeout_ms) override;
     IoStatus DoRead(uint8_t* data, size_t capacity, size_t* received, uint32_t timeout_ms) override;
     IoStatus DoReconnect(uint32_t timeout_ms) override;
-    const char* DoLastError() const override { return last_error_.c_str(); }
+    FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
     IoStatus Fail(IoStatus status, const std::string& detail);
     bool Usable();
 

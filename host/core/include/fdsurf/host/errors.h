@@ -8,6 +8,7 @@
 
 #include <stdexcept>
 #include <string>
+#include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf::host {
 
@@ -32,12 +33,14 @@ class OptionError : public InputError {
         value_(std::move(value)),
         problem_(std::move(problem)) {}
 
-  const std::string& field() const { return field_; }
-  const std::string& value() const { return value_; }
-  const std::string& problem() const { return problem_; }
+  FDSURF_NODISCARD const std::string& field() const { return field_; }
+  FDSURF_NODISCARD const std::string& value() const { return value_; }
+  FDSURF_NODISCARD const std::string& problem() const { return problem_; }
 
   /// The message with `name` in place of the field.
-  std::string MessageFor(const std::string& name) const { return Compose(name, value_, problem_); }
+  FDSURF_NODISCARD std::string MessageFor(const std::string& name) const {
+    return Compose(name, value_, problem_);
+  }
 
  private:
   static std::string Compose(const std::string& field, const std::string& value,

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/fixed.h"
 
 namespace fdsurf::host {
@@ -18,16 +19,16 @@ class Quantum {
   static Quantum Parse(const std::string& text, const std::string& what = "quantum");
 
   /// Q = mantissa · 10^-decimals.
-  std::int64_t mantissa() const { return mantissa_; }
-  int decimals() const { return decimals_; }
-  double value() const;
+  FDSURF_NODISCARD std::int64_t mantissa() const { return mantissa_; }
+  FDSURF_NODISCARD int decimals() const { return decimals_; }
+  FDSURF_NODISCARD double value() const;
 
   /// value / Q as a double, with about 2^-52 relative error (one rounding
   /// for the product, one for the quotient).
-  double ToQuanta(double value) const;
+  FDSURF_NODISCARD double ToQuanta(double value) const;
 
   /// The exact decimal text of k·Q ("-1.400" for k = -1400, Q = 0.001).
-  std::string Format(std::int64_t k) const;
+  FDSURF_NODISCARD std::string Format(std::int64_t k) const;
 
  private:
   std::int64_t mantissa_ = 1;

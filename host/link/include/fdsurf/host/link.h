@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/protocol/codec.h"
 #include "fdsurf/protocol/frame.h"
 #include "fdsurf/protocol/messages.h"
@@ -90,7 +91,7 @@ class HostLink {
   /// The earliest time at which Poll() will have something to do if no bytes
   /// arrive meanwhile (for event-driven and virtual-time loops); `now_us`
   /// if it has something to do now, UINT64_MAX if nothing is pending.
-  uint64_t NextPollUs(uint64_t now_us) const;
+  FDSURF_NODISCARD uint64_t NextPollUs(uint64_t now_us) const;
 
   /// After a reconnect: re-handshake with a resume HELLO (no new-session
   /// flag), then continue from the device's next_seq. Drops any partly
@@ -100,27 +101,31 @@ class HostLink {
 
   /// Sends STOP (repeated until acknowledged) and no further commands.
   void RequestStop();
-  bool StopAcknowledged() const { return stop_acked_; }
+  FDSURF_NODISCARD bool StopAcknowledged() const { return stop_acked_; }
 
   /// Handshake done (a HELLO_REPLY arrived since the last Resume()).
-  bool Connected() const { return state_ == State::kRunning; }
+  FDSURF_NODISCARD bool Connected() const { return state_ == State::kRunning; }
   /// Every enqueued command is acknowledged by the device.
-  bool AllAcknowledged() const { return state_ == State::kRunning && queue_.empty(); }
+  FDSURF_NODISCARD bool AllAcknowledged() const {
+    return state_ == State::kRunning && queue_.empty();
+  }
   /// All acknowledged and a status report (requested after the last
   /// acknowledgement) shows every command executed and the device idle.
-  bool Finished() const;
-  bool Failed() const { return state_ == State::kFailed; }
+  FDSURF_NODISCARD bool Finished() const;
+  FDSURF_NODISCARD bool Failed() const { return state_ == State::kFailed; }
   /// What went wrong, when Failed().
-  const std::string& error() const { return error_; }
+  FDSURF_NODISCARD const std::string& error() const { return error_; }
 
-  const HostLinkStats& stats() const { return stats_; }
+  FDSURF_NODISCARD const HostLinkStats& stats() const { return stats_; }
   /// Frames the host's decoder dropped (CRC, COBS, overlong).
-  const protocol::FrameDecoderStats& frame_stats() const { return decoder_.stats(); }
-  const std::optional<protocol::StatusReport>& status() const { return status_; }
-  const std::optional<protocol::HelloReply>& hello() const { return hello_; }
+  FDSURF_NODISCARD const protocol::FrameDecoderStats& frame_stats() const {
+    return decoder_.stats();
+  }
+  FDSURF_NODISCARD const std::optional<protocol::StatusReport>& status() const { return status_; }
+  FDSURF_NODISCARD const std::optional<protocol::HelloReply>& hello() const { return hello_; }
   /// Commands enqueued since construction, and acknowledged.
-  uint64_t enqueued() const { return enqueued_; }
-  uint64_t acknowledged() const { return enqueued_ - queue_.size(); }
+  FDSURF_NODISCARD uint64_t enqueued() const { return enqueued_; }
+  FDSURF_NODISCARD uint64_t acknowledged() const { return enqueued_ - queue_.size(); }
 
  private:
   enum class State { kHandshake, kRunning, kFailed };
@@ -144,10 +149,12 @@ class HostLink {
   void SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out);
   // Counts a timeout; returns true (and fails) after max_retries in a row.
   bool Timeout();
-  std::string Describe(size_t index) const;
-  uint16_t SeqOf(size_t index) const { return static_cast<uint16_t>(base_seq_ + index); }
-  size_t SendLimit() const;
-  uint64_t RetransmitTimerStart() const;
+  FDSURF_NODISCARD std::string Describe(size_t index) const;
+  FDSURF_NODISCARD uint16_t SeqOf(size_t index) const {
+    return static_cast<uint16_t>(base_seq_ + index);
+  }
+  FDSURF_NODISCARD size_t SendLimit() const;
+  FDSURF_NODISCARD uint64_t RetransmitTimerStart() const;
 
   HostLinkOptions options_;
   State state_ = State::kHandshake;

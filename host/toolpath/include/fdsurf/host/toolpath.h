@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fdsurf/adaptive.h"
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/quantum.h"
@@ -81,8 +82,8 @@ struct OutputMap {
   View view;
   double scale = 1.0;
   std::array<double, 3> offset{};
-  std::array<double, 3> Apply(const Point3& p) const;
-  std::array<double, 3> ApplyLinear(const Point3& p) const;
+  FDSURF_NODISCARD std::array<double, 3> Apply(const Point3& p) const;
+  FDSURF_NODISCARD std::array<double, 3> ApplyLinear(const Point3& p) const;
 };
 
 /// One drawn curve: whole-quantum points (z = 0 when dims = 2) and where

@@ -4,7 +4,7 @@
 of the emulator runs (ctest --test-dir build -L targets writes them to
 build/targets/<target>/results/).
 
-Usage: python3 targets/tools/report.py [BUILD_DIR]
+Usage: python3 targets/tools/target_report.py [BUILD_DIR]
 """
 import os
 import sys
