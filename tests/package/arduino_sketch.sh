@@ -49,7 +49,7 @@ cp "$sketch_src"/* "$work/sketch/"
 } >"$work/sketch/FdsurfCurve.ino.cpp"
 compile "$work/sketch/FdsurfCurve.ino.cpp" "$work/obj/sketch.o"
 compile "$work/sketch/bezier_curve.cpp" "$work/obj/bezier_curve.o"
-compile "$shim/main.cpp" "$work/obj/shim_main.o"
+compile "$shim/arduino_main.cpp" "$work/obj/shim_main.o"
 
 elf=$work/FdsurfCurve.ino.elf
 avr-gcc -w -Os -g -flto -fuse-linker-plugin -Wl,--gc-sections -mmcu=atmega2560 -o "$elf" \

@@ -54,7 +54,7 @@ c++ -std=c++14 -o "$work/pc_core" "$here/consumer/core_main.cc" $(pkg-config --c
 check "pkg-config fdsurf" "$expected_curve" "$("$work/pc_core")"
 if [ "$mode" != core-only ]; then
   # The libraries are static: --static brings in cairo (Requires.private).
-  c++ -std=c++20 -o "$work/pc_host" "$here/consumer/main.cc" \
+  c++ -std=c++20 -o "$work/pc_host" "$here/consumer/host_consumer.cc" \
     $(pkg-config --static --cflags --libs fdsurf-host)
   check "pkg-config fdsurf-host" "patches: 32
 $expected_curve" "$("$work/pc_host" "$examples/teapot.bpt")"

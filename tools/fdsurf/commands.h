@@ -3,7 +3,7 @@
 // check_command.cc, plot_command.cc (plot and render), stream_command.cc,
 // construct_commands.cc (joins). Each Run* returns the exit code: 0 done,
 // 1 a bound broken, 2 bad input; they throw InputError, OptionError,
-// OutputError and EngineError, which main.cc reports.
+// OutputError and EngineError, which fdsurf.cc reports.
 #pragma once
 
 #include <string>

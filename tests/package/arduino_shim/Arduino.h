@@ -4,7 +4,7 @@
 // library's names (min, max, abs, round, bit, HIGH, DEC, byte, ...), and a
 // Serial that writes to USART0 without interrupts, so tests/package/
 // arduino_sketch.sh can compile a sketch as the IDE does and run it under
-// simavr. main.cpp calls setup() and loop() once, then reports exit 0.
+// simavr. arduino_main.cpp calls setup() and loop() once, then reports exit 0.
 #pragma once
 
 #include <avr/interrupt.h>
