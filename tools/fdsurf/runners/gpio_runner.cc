@@ -8,13 +8,18 @@
 #include "fdsurf/device/device.h"
 #include "fdsurf/hal/gpiod_outputs.h"
 #include "fdsurf/hal/monotonic_clock.h"
+#include "fdsurf/hal/tick_scheduler.h"
 #include "runner.h"
+#include "tick_loop.h"
 
 namespace fdsurf::host {
 
 // This host is the controller: the firmware's Device runs here, in real time,
-// on GPIO lines. Ticks can only come late (never early), so speeds and
-// accelerations can only come out below the configured limits.
+// on GPIO lines (tick_loop.h). A tick can only come late, and the next one is
+// due a full period after it, so the path speed can only come out below the
+// configured limit. A stall longer than a period stops the motion abruptly
+// and resumes it at the speed it had (the device does not know about the
+// stall): a stepper at speed may lose steps there, which the summary reports.
 int RunGpio(const StreamOptions& o, const StreamJob& job) {
   hal::GpiodConfig config;
   std::string error;
@@ -33,31 +38,18 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
   hal::MonotonicClock clock;
+  // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
+  hal::TickScheduler ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz);
   const auto run = [&](auto& device) {
-    std::vector<std::uint8_t> out;
-    std::uint8_t in[256];
-    const std::uint64_t tick_us = 1'000'000 / tick_hz;
-    std::uint64_t next_tick = clock.NowMicros();
     std::uint64_t last_progress = 0;
-    std::uint64_t ticks = 0;
-    while (!link.Finished() && !link.Failed()) {
-      if (ticks++ % 16 == 0) {
-        const std::uint64_t now = clock.NowMicros();
-        out.clear();
-        link.Poll(now, &out);
-        for (const std::uint8_t byte : out) device.OnByte(byte);
-        for (std::size_t n; (n = device.ReadOutput(in, sizeof in)) > 0;) link.OnBytes(in, n, now);
-        device.Fill();
-        if (now - last_progress > 250'000) {
-          last_progress = now;
-          progress.Show(device.executed(), job.commands.size(), link.stats().frames_sent, 0);
-        }
-      }
-      next_tick += tick_us;
-      clock.SleepUntilMicros(next_tick);
-      if (device.Tick(*outputs, *outputs) != hal::IoStatus::kOk) {
-        throw DeviceError(std::string("gpio: ") + outputs->StepDirOutputs::LastError());
-      }
+    const auto show_progress = [&](std::uint64_t now) {
+      if (now - last_progress <= 250'000) return;
+      last_progress = now;
+      progress.Show(device.executed(), job.commands.size(), link.stats().frames_sent, 0);
+    };
+    if (RunTickLoop(clock, ticks, link, device, *outputs, *outputs, show_progress) !=
+        hal::IoStatus::kOk) {
+      throw DeviceError(std::string("gpio: ") + outputs->StepDirOutputs::LastError());
     }
   };
   if (o.dims == 3) {
@@ -72,6 +64,14 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   if (!o.quiet) {
     std::fprintf(stderr, "%s: %zu patches drawn on %s at %u Hz ticks\n", o.file.c_str(),
                  job.patches.size(), o.device.c_str(), tick_hz);
+    if (ticks.late_ticks() != 0) {
+      std::fprintf(stderr,
+                   "gpio: %llu of %llu ticks came a period or more late (longest %.1f ms): the "
+                   "motion was stretched there\n",
+                   static_cast<unsigned long long>(ticks.late_ticks()),
+                   static_cast<unsigned long long>(ticks.ticks()),
+                   static_cast<double>(ticks.max_lateness_us()) / 1000.0);
+    }
   }
   return 0;
 }
