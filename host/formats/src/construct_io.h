@@ -6,20 +6,26 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
 
-/// Where a JSON value sits, for messages: "file: surfaces[0].net[1][2]: ...".
+/// Where a JSON value sits, for messages: "file: surfaces[0].net[1][2]: ...";
+/// a top-level field is named without a dot ("file: units: ...").
 struct JsonPlace {
   const std::string& file;
   std::string path;
-  InputError Error(const std::string& what) const {
+  FDSURF_NODISCARD InputError Error(const std::string& what) const {
     return InputError(file + ": " + (path.empty() ? "" : path + ": ") + what);
   }
-  JsonPlace Child(const std::string& key) const { return {file, path + "." + key}; }
-  JsonPlace Index(std::size_t i) const { return {file, path + "[" + std::to_string(i) + "]"}; }
+  FDSURF_NODISCARD JsonPlace Child(const std::string& key) const {
+    return {file, path.empty() ? key : path + "." + key};
+  }
+  FDSURF_NODISCARD JsonPlace Index(std::size_t i) const {
+    return {file, path + "[" + std::to_string(i) + "]"};
+  }
 };
 
 /// A basis name ("bezier", "hermite", ...); InputError at `place` otherwise.

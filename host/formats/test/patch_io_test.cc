@@ -140,7 +140,7 @@ TEST(Json, RefusesMalformedInputNamingTheField) {
   EXPECT_EQ(ErrorOf([&] { ParseJson(R"({"units": "mm"})", "f.json"); }),
             "f.json: missing \"surfaces\"");
   EXPECT_EQ(ErrorOf([&] { ParseJson(R"({"units": "furlong", "surfaces": []})", "f.json"); }),
-            "f.json: .units: must be \"mm\" or \"in\"");
+            "f.json: units: must be \"mm\" or \"in\"");
   EXPECT_EQ(
       ErrorOf([&] { ParseJson(R"({"surface": []})", "f.json"); }),
       "f.json: unknown field \"surface\" (expected \"units\", \"surfaces\", \"construct\" and "

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
@@ -22,10 +23,10 @@ struct Quadric {
   Point3 p{};
   Point3 a{};
   std::array<std::array<double, 3>, 3> m{};
-  double Value(const Point3& x) const;
-  Point3 Gradient(const Point3& x) const;
+  FDSURF_NODISCARD double Value(const Point3& x) const;
+  FDSURF_NODISCARD Point3 Gradient(const Point3& x) const;
   /// Q(d) = dᵀ·M·d, the quadratic part along a direction.
-  double Form(const Point3& d, const Point3& e) const;
+  FDSURF_NODISCARD double Form(const Point3& d, const Point3& e) const;
 };
 
 /// The names of the unknowns of the linear system, in order:
@@ -44,7 +45,7 @@ struct QuadricSolution {
   std::vector<std::array<double, 8>> null;
   /// The quadric for the given free parameter values (as many as
   /// free_unknowns; each is the value of that unknown).
-  Quadric With(const std::vector<double>& parameters) const;
+  FDSURF_NODISCARD Quadric With(const std::vector<double>& parameters) const;
   Point3 p1{};
   Point3 a1{};
 };
