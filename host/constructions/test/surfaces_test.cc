@@ -129,6 +129,34 @@ TEST(Coons, RefusesBoundariesWhoseCornersDoNotMeet) {
       "boundary 3 (r(1,v)) ends at (3, 3.5, 0), 0.5 apart (tolerance 3.5e-09)");
 }
 
+TEST(Constructions, CountsThatMustBeExactSayExactly) {
+  // Too few is refused as "exactly", like too many: nothing else is accepted.
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "ruled", "curves": [
+                {"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]}]}]})",
+                        "r.json");
+            }),
+            "r.json: construct[0].curves: a ruled surface takes exactly 2 curves, got 1");
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"construct": [{"type": "bilinear", "corners": [[0,0],[1,0],[0,1]]}]})",
+                        "b.json");
+            }),
+            "b.json: construct[0].corners: needs exactly 4 corners [P00, P10, P01, P11], got 3");
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"curves": [{"type": "cubic", "basis": "bezier",
+                                        "points": [[0,0],[1,0],[2,0]]}]})",
+                        "c.json");
+            }),
+            "c.json: curves[0].points: a cubic needs exactly 4 points, got 3");
+  EXPECT_EQ(InputErrorOf([] {
+              ParseJson(R"({"curves": [{"type": "hermite", "points": [[0,0]],
+                                        "vectors": [[1,0]]}]})",
+                        "c.json");
+            }),
+            "c.json: curves[0].points: a hermite segment has exactly 2 points, got 1; use "
+            "hermite-chain");
+}
+
 // F(u,v) = (u, v, sin(u)·cos(v) + u·v/4) and its first derivatives.
 Point3 F(double u, double v) { return {u, v, std::sin(u) * std::cos(v) + u * v / 4}; }
 Point3 Fu(double u, double v) { return {1, 0, std::cos(u) * std::cos(v) + v / 4}; }

@@ -95,7 +95,7 @@ Curve ParseCubic(const json& value, const Place& place) {
   CheckFields(value, place, {"basis", "points"}, {"basis", "points"});
   Curve curve;
   curve.basis = ParseBasis(value["basis"], place.Child("basis"));
-  const std::vector<Point3> points = ParsePoints(value["points"], place.Child("points"), 4);
+  const std::vector<Point3> points = ParsePoints(value["points"], place.Child("points"), 0);
   if (points.size() != 4) {
     throw place.Child("points").Error("a cubic needs exactly 4 points, got " +
                                       std::to_string(points.size()));
@@ -178,9 +178,11 @@ bool CurveIsClosed(const std::vector<Curve>& segments) {
 
 void AddRuled(const json& e, const Place& place, PatchSet* set) {
   CheckFields(e, place, {"type", "curves"}, {"curves"});
-  const auto family = ParseFamily(e["curves"], place.Child("curves"), 2);
-  if (family.size() != 2)
-    throw place.Child("curves").Error("a ruled surface takes exactly 2 curves");
+  const auto family = ParseFamily(e["curves"], place.Child("curves"), 0);
+  if (family.size() != 2) {
+    throw place.Child("curves").Error("a ruled surface takes exactly 2 curves, got " +
+                                      std::to_string(family.size()));
+  }
   for (std::size_t k = 0; k < family[0].size(); ++k) {
     Append(RuledSurface(family[0][k], family[1][k]), 1, SegmentOrigin(place, k, family[0].size()),
            set);
@@ -189,9 +191,10 @@ void AddRuled(const json& e, const Place& place, PatchSet* set) {
 
 void AddBilinear(const json& e, const Place& place, PatchSet* set) {
   CheckFields(e, place, {"type", "corners"}, {"corners"});
-  const auto c = ParsePoints(e["corners"], place.Child("corners"), 4);
+  const auto c = ParsePoints(e["corners"], place.Child("corners"), 0);
   if (c.size() != 4) {
-    throw place.Child("corners").Error("needs exactly 4 corners [P00, P10, P01, P11]");
+    throw place.Child("corners").Error("needs exactly 4 corners [P00, P10, P01, P11], got " +
+                                       std::to_string(c.size()));
   }
   Append(BilinearSurface(c[0], c[1], c[2], c[3]), 1, SegmentOrigin(place, 0, 1), set);
 }
@@ -449,9 +452,12 @@ void AddCurve(const json& e, const Place& place, PatchSet* set) {
         R"(unknown curve type (expected "cubic", "hermite" or "hermite-chain"))");
   }
   CheckFields(e, place, {"type", "points", "vectors"}, {"points", "vectors"});
-  const std::vector<Point3> points = ParsePoints(e["points"], place.Child("points"), 2);
-  if (type == "hermite" && points.size() != 2) {
-    throw place.Child("points").Error("a hermite segment has exactly 2 points; use hermite-chain");
+  const bool segment = type == "hermite";
+  const std::vector<Point3> points =
+      ParsePoints(e["points"], place.Child("points"), segment ? 0 : 2);
+  if (segment && points.size() != 2) {
+    throw place.Child("points").Error("a hermite segment has exactly 2 points, got " +
+                                      std::to_string(points.size()) + "; use hermite-chain");
   }
   const Place vp = place.Child("vectors");
   const json& vectors = e["vectors"];
