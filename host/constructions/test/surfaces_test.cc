@@ -157,6 +157,26 @@ TEST(Constructions, CountsThatMustBeExactSayExactly) {
             "hermite-chain");
 }
 
+TEST(Ruled, RefusesAPiecewiseCurveWhoseSegmentsDoNotMeet) {
+  // The second segment of curve 1 starts 0.5 above where the first ends.
+  const auto read = [](const char* second_start) {
+    ParseJson(std::string(R"({"construct": [{"type": "ruled", "curves": [
+      [{"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]},
+       {"basis": "bezier", "points": [[3,0],[4,0],[5,0],[6,0]]}],
+      [{"basis": "bezier", "points": [[0,3],[1,3],[2,3],[3,3]]},
+       {"basis": "bezier", "points": [)") +
+                  second_start + R"(,[4,3],[5,3],[6,3]]}]]}]})",
+              "r.json");
+  };
+  EXPECT_EQ(InputErrorOf([&] { read("[3,3.5]"); }),
+            "r.json: construct[0].curves[1]: construct[0].curves[1][0] ends at (3, 3, 0) but "
+            "construct[0].curves[1][1] starts at (3, 3.5, 0), 0.5 apart (tolerance 6e-09): the "
+            "segments of a piecewise curve must meet");
+  // Within the tolerance (10⁻⁹ of the curve's size) it is a join.
+  EXPECT_EQ(InputErrorOf([&] { read("[3,3.000000001]"); }), "(no error)");
+  EXPECT_EQ(InputErrorOf([&] { read("[3,3]"); }), "(no error)");
+}
+
 // F(u,v) = (u, v, sin(u)·cos(v) + u·v/4) and its first derivatives.
 Point3 F(double u, double v) { return {u, v, std::sin(u) * std::cos(v) + u * v / 4}; }
 Point3 Fu(double u, double v) { return {1, 0, std::cos(u) * std::cos(v) + v / 4}; }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "construct_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <initializer_list>
@@ -105,6 +106,32 @@ Curve ParseCubic(const json& value, const Place& place) {
   return curve;
 }
 
+// Corners and edges closer than this (relative to the geometry's size) match.
+constexpr double kMatchTolerance = 1e-9;
+
+// Each segment of a piecewise curve starts where the one before it ends,
+// within kMatchTolerance times the size of the curve's joints (at least 1).
+void CheckSegmentsMeet(const std::vector<Curve>& segments, const Place& place) {
+  double scale = 1;
+  for (const Curve& c : segments) {
+    for (const double u : {0.0, 1.0}) {
+      for (const double x : EvaluateCurve(c, u)) scale = std::max(scale, std::fabs(x));
+    }
+  }
+  for (std::size_t k = 1; k < segments.size(); ++k) {
+    const Point3 end = EvaluateCurve(segments[k - 1], 1);
+    const Point3 start = EvaluateCurve(segments[k], 0);
+    const double gap = std::hypot(end[0] - start[0], end[1] - start[1], end[2] - start[2]);
+    if (!(gap <= kMatchTolerance * scale)) {
+      throw place.Error(place.Index(k - 1).path + " ends at " + FormatPoint(end) + " but " +
+                        place.Index(k).path + " starts at " + FormatPoint(start) + ", " +
+                        FormatNumber(gap, 9) + " apart (tolerance " +
+                        FormatNumber(kMatchTolerance * scale, 9) +
+                        "): the segments of a piecewise curve must meet");
+    }
+  }
+}
+
 // A cubic, or an array of cubics joined end to end (a piecewise curve).
 std::vector<Curve> ParsePiecewise(const json& value, const Place& place) {
   if (value.is_object()) return {ParseCubic(value, place)};
@@ -114,6 +141,7 @@ std::vector<Curve> ParsePiecewise(const json& value, const Place& place) {
   std::vector<Curve> segments;
   for (std::size_t k = 0; k < value.size(); ++k)
     segments.push_back(ParseCubic(value[k], place.Index(k)));
+  CheckSegmentsMeet(segments, place);
   return segments;
 }
 
@@ -164,8 +192,6 @@ void Append(const PolySurface& surface, double tolerance, const std::string& ori
 
 // The default tolerance of approximated constructions, in file units.
 constexpr double kApproximationTolerance = 1e-6;
-// Corners and edges closer than this (relative to the geometry's size) match.
-constexpr double kMatchTolerance = 1e-9;
 
 bool CurveIsClosed(const std::vector<Curve>& segments) {
   const Point3 a = EvaluateCurve(segments.front(), 0);
