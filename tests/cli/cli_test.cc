@@ -194,6 +194,18 @@ TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
   ExpectRefused("sample '" + broken + "' --grid 4", "d.json:2:2: invalid JSON");
   const std::string empty = Write("e.bpt", "  \n");
   ExpectRefused("sample '" + empty + "' --grid 4", "e.bpt:1: file ends where the number");
+  // A top-level field is named without a leading dot, like the nested ones.
+  const std::string units = Write("u.json", R"({"units": "furlong", "surfaces": []})");
+  ExpectRefused("sample '" + units + "' --grid 4", "/u.json: units: must be \"mm\" or \"in\"");
+  // A piecewise curve whose segments do not meet: both segments and the gap.
+  const std::string torn = Write("r.json", R"({"construct": [{"type": "ruled", "curves": [
+    [{"basis": "bezier", "points": [[0,0],[1,0],[2,0],[3,0]]},
+     {"basis": "bezier", "points": [[3,0.25],[4,0],[5,0],[6,0]]}],
+    [{"basis": "bezier", "points": [[0,3],[1,3],[2,3],[3,3]]},
+     {"basis": "bezier", "points": [[3,3],[4,3],[5,3],[6,3]]}]]}]})");
+  ExpectRefused("check '" + torn + "' --grid 4",
+                "r.json: construct[0].curves[0]: construct[0].curves[0][0] ends at (3, 0, 0) but "
+                "construct[0].curves[0][1] starts at (3, 0.25, 0), 0.25 apart (tolerance 6e-09)");
 }
 
 // Bad plot options: a clear message, a non-zero exit, and no output file at
