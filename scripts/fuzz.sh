@@ -69,13 +69,15 @@ for t in $targets; do
     [ -d "$dir" ] && inputs+=($(find "$dir" -type f ! -name '.*' | sort))
   done
   echo "== fuzz: $t: ${#inputs[@]} regression and corpus inputs"
-  if [ ${#inputs[@]} -gt 0 ] &&
-    ! "$bin" -artifact_prefix="$work/artifacts/$t/" -timeout=60 "${inputs[@]}" \
-      >"$work/$t.regressions.log" 2>&1; then
-    tail -n 30 "$work/$t.regressions.log" >&2
-    report "$t" "regression run"
-    continue
-  fi
+  # One process per input, so that every failing one is named (libFuzzer
+  # stops at the first, and writes no artifact for an input given as a file).
+  for input in "${inputs[@]}"; do
+    if ! "$bin" -timeout=60 "$input" >"$work/$t.regression.log" 2>&1; then
+      grep -E 'FINDING|SUMMARY|runtime error' "$work/$t.regression.log" | head -n 5 >&2 || true
+      echo "fuzz: FINDING in $t (regression run) on $input" >&2
+      failed=1
+    fi
+  done
 done
 if [ "$failed" != 0 ]; then exit 1; fi
 
