@@ -11,6 +11,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   clang-format clang-tidy
+  # The libFuzzer targets (scripts/fuzz.sh): clang and its runtimes
+  # (libclang_rt.fuzzer and the sanitizers are in libclang-rt-14-dev).
+  clang libclang-rt-14-dev
   libcairo2-dev
   libusb-1.0-0-dev libgpiod-dev gpiod
   python3 hp2xx librsvg2-bin

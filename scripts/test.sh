@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 # Sets everything up (Debian packages, build) and runs every check: the test
 # suite, the same suite under AddressSanitizer + UndefinedBehaviorSanitizer,
-# clang-format and clang-tidy. Exits non-zero on the first failure.
+# the libFuzzer targets, clang-format and clang-tidy. Exits non-zero on the
+# first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -33,6 +34,10 @@ FDSURF_BUILD_DIR=build-sanitize FDSURF_BUILD_TYPE=Debug \
   FDSURF_CMAKE_ARGS="-DFDSURF_SANITIZE=ON -DFDSURF_BUILD_BENCH=OFF" bash scripts/setup.sh
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-sanitize --output-on-failure --parallel "$jobs"
+
+echo "== fuzz targets under ASan+UBSan: regressions and corpora, then 45 s of fuzzing each"
+# fuzz/README.md; a long run by hand: bash scripts/fuzz.sh 3600
+bash scripts/fuzz.sh 45
 
 echo "== clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
