@@ -10,8 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/sim/checks.h"
 #include "fdsurf/sim/plotter.h"
 
@@ -126,6 +128,66 @@ TEST(CheckMotion, CatchesEveryKindOfViolation) {
   // A step 2 ms after a pen change with a 10 ms pen delay.
   const std::vector<hal::PenEvent> pen = {{good[150].time_us - 2000, true}};
   EXPECT_GT(CheckMotion(good, pen, limits).violations, 0u);
+}
+
+// Issue 12, defect 3: at a 0.1 mm margin the device refused patch 31 (its
+// bottom reached 0.8 steps below the page) after 7 patches were drawn: the
+// host's fit had missed the extremum of a line whose cubic term is rounding
+// noise. Now the fit is right, the drawing fits, and the host asks the
+// device's own validation about every command before sending any.
+TEST(BuildStreamJob, TheTeapotAtATenthOfAMillimetreMarginFitsTheDevice) {
+  host::ToolpathOptions options;  // as `fdsurf stream examples/teapot.bpt --margin 0.1`
+  options.view = *host::NamedView("iso");
+  options.fit = std::array<double, 2>{200, 150};
+  options.margin = 0.1;
+  options.lines_s = 8;
+  options.lines_t = 8;
+  options.tolerance = 0.05;
+  options.mode = host::StepMode::kStepExact;
+  const host::StreamJob job = host::BuildStreamJob(Teapot(), options, host::MachineOptions{}, "mm");
+  ASSERT_EQ(job.config.travel_steps[1], 12000);
+  for (std::size_t k = 0; k < job.commands.size(); ++k) {
+    std::uint8_t detail = 0;
+    EXPECT_EQ(motion::ValidateCommand<2>(job.commands[k], job.config, &detail),
+              protocol::ErrorCode::kNone)
+        << job.labels[k] << " detail " << int{detail};
+  }
+}
+
+// Issue 12, defect 1: two patches 70 m apart at 1 µm steps need a travel the
+// device cannot move in one straight line (2^26 steps); the job was sent and
+// the device faulted mid-job. The host refuses it before sending anything,
+// in millimetres.
+TEST(BuildStreamJob, RefusesATravelTheDeviceCannotMove) {
+  host::PatchSet far;
+  far.patches.push_back(Teapot().patches[0]);
+  far.patches.push_back(Teapot().patches[0]);
+  for (auto& row : far.patches[1].g) {
+    for (auto& point : row) point[0] += 70000;
+  }
+  host::ToolpathOptions options;
+  options.view = *host::NamedView("top");
+  options.lines_s = 2;
+  options.lines_t = 2;
+  options.tolerance = 0.005;
+  options.mode = host::StepMode::kStepExact;
+  host::MachineOptions machine;
+  machine.step = host::Quantum::Parse("0.001");
+  machine.speed = 10;
+  machine.accel = 100;
+  try {
+    (void)host::BuildStreamJob(far, options, machine, "mm");
+    FAIL() << "accepted a travel of more than 2^26 steps";
+  } catch (const host::OptionError& error) {
+    EXPECT_EQ(error.field(), "travel X");
+    EXPECT_NE(error.problem().find("67108.9 mm"), std::string::npos) << error.what();
+  }
+  // Inside the cap the same pair is accepted, every command as the device will.
+  for (auto& row : far.patches[1].g) {
+    for (auto& point : row) point[0] -= 10000;
+  }
+  const host::StreamJob job = host::BuildStreamJob(far, options, machine, "mm");
+  EXPECT_LE(job.config.travel_steps[0], motion::kMaxPlannableTravelSteps);
 }
 
 TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {
