@@ -190,6 +190,54 @@ TEST(BuildStreamJob, RefusesATravelTheDeviceCannotMove) {
   EXPECT_LE(job.config.travel_steps[0], motion::kMaxPlannableTravelSteps);
 }
 
+// Issue 12, defect 2: the simulator's time stood still while the device
+// computed, so a slow validation never showed. With the ATmega2560's cost
+// model a 1025×1025-line PATCH keeps the device's main loop busy for
+// seconds of virtual time: the host sees no answer and times out.
+TEST(SimulatedPlotter, ChargesTheDevicesComputeTime) {
+  protocol::Command config;
+  config.type = protocol::MessageType::kConfig;
+  config.seq = 0;
+  config.body.config = protocol::MachineConfig{};
+  config.body.config.axes = 2;
+  config.body.config.steps_per_meter[0] = config.body.config.steps_per_meter[1] = 80000;
+  config.body.config.travel_steps[0] = config.body.config.travel_steps[1] = 100;
+  config.body.config.max_rate = 8000;
+  config.body.config.accel = 160000;
+  protocol::Command patch;
+  patch.type = protocol::MessageType::kPatch;
+  patch.seq = 0;
+  patch.body.patch = protocol::PatchCommand{};
+  patch.body.patch.basis = Basis::kBezier;
+  patch.body.patch.dims = 2;
+  patch.body.patch.lines_s = patch.body.patch.lines_t = 1025;
+  patch.body.patch.tolerance_q8 = 512;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {  // a 6×6-step square
+      patch.body.patch.geometry[0].g[i][j] = GeometryFixed::FromRaw((10 + 2 * j) * 65536);
+      patch.body.patch.geometry[1].g[i][j] = GeometryFixed::FromRaw((10 + 2 * i) * 65536);
+    }
+  }
+  const auto run = [&](const DeviceCost& cost) {
+    PlotterOptions options;
+    options.device_cost = cost;
+    SimulatedPlotter plotter(options);
+    host::HostLink link;
+    EXPECT_TRUE(link.Enqueue(config, "config").ok());
+    EXPECT_TRUE(link.Enqueue(patch, "patch").ok());
+    return plotter.Run(link, 600ull * 1'000'000);
+  };
+  const RunResult free = run(DeviceCost{});
+  ASSERT_TRUE(free.finished) << free.error;
+  EXPECT_EQ(free.host.timeouts, 0u);
+  const DeviceCost avr = DeviceCost::Atmega2560();
+  const std::uint64_t busy_us = avr.Microseconds(motion::ValidationWork{2050, 3 * 2050});
+  EXPECT_GT(busy_us, 1'000'000u);  // seconds on the Mega
+  const RunResult slow = run(avr);
+  EXPECT_GT(slow.host.timeouts, 0u);
+  if (slow.finished) EXPECT_GE(slow.acknowledged_us, free.acknowledged_us + busy_us);
+}
+
 TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {
   const host::StreamJob job = SmallTeapotJob();
   // The teapot's patches share edges; each is drawn once (the gap check below
