@@ -104,9 +104,11 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
   bool holding_ = false;
 };
 
-// Measured: targets/ validate-frame and validate-graze on the ATmega2560.
-constexpr std::uint32_t kAvrCyclesPerLine = 490000;
-constexpr std::uint32_t kAvrCyclesPerHullTest = 0;
+// Measured under simavr (docs/motion.md): a hull test is validate-graze
+// less validate-inside over its 19 tests; a line is validate-frame per line
+// less its 3 hull tests.
+constexpr std::uint32_t kAvrCyclesPerLine = 430776;
+constexpr std::uint32_t kAvrCyclesPerHullTest = 19982;
 
 DeviceCost DeviceCost::Atmega2560() {
   return DeviceCost{16'000'000, kAvrCyclesPerLine, kAvrCyclesPerHullTest};
