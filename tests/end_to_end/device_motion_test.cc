@@ -409,7 +409,7 @@ TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {
   EXPECT_EQ(detail, 1);
   // A curve that dips below y = 0 is refused; one whose control points lie
   // below 0 but whose curve stays above is accepted: the hull test alone
-  // would refuse it, the dry run of its points decides.
+  // would refuse it, halving the hull decides.
   protocol::Command curve;
   curve.type = protocol::MessageType::kCurve;
   curve.body.curve.basis = Basis::kBezier;
