@@ -21,6 +21,7 @@ class DeviceRunner {
   FDSURF_NODISCARD virtual const protocol::DeviceLinkStats& link_stats() const = 0;
   FDSURF_NODISCARD virtual const protocol::FrameDecoderStats& frame_stats() const = 0;
   FDSURF_NODISCARD virtual std::uint32_t executed() const = 0;
+  FDSURF_NODISCARD virtual motion::ValidationWork validation_work() const = 0;
 };
 
 }  // namespace internal
@@ -44,6 +45,9 @@ class AxesRunner final : public internal::DeviceRunner {
     return device_.frame_stats();
   }
   FDSURF_NODISCARD std::uint32_t executed() const override { return device_.executed(); }
+  FDSURF_NODISCARD motion::ValidationWork validation_work() const override {
+    return device_.validation_work();
+  }
 
  private:
   device::Device<kAxes, 8, 1024> device_;
@@ -61,9 +65,24 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
   FaultyTransport& operator=(const FaultyTransport&) = delete;
   FDSURF_NODISCARD const FaultStats& stats() const { return faults_.stats(); }
 
+  /// While held, what the device writes waits (it is still computing);
+  /// Release() sends it.
+  void Hold() { holding_ = true; }
+  hal::IoStatus Release() {
+    holding_ = false;
+    if (held_.empty()) return hal::IoStatus::kOk;
+    const std::vector<std::uint8_t> out = std::move(held_);
+    held_.clear();
+    return Write(out.data(), out.size(), 100);
+  }
+
  private:
   hal::IoStatus DoWrite(const std::uint8_t* data, std::size_t size,
                         std::uint32_t timeout_ms) override {
+    if (holding_) {
+      held_.insert(held_.end(), data, data + size);
+      return hal::IoStatus::kOk;
+    }
     faulted_.clear();
     faults_.Process(data, size, &faulted_);
     if (faulted_.empty()) return hal::IoStatus::kOk;
@@ -81,7 +100,26 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
   hal::Transport& inner_;
   FaultLink faults_;
   std::vector<std::uint8_t> faulted_;
+  std::vector<std::uint8_t> held_;
+  bool holding_ = false;
 };
+
+// Measured under simavr (docs/motion.md): a hull test is validate-graze
+// less validate-inside over its 19 tests; a line is validate-frame per line
+// less its 3 hull tests.
+constexpr std::uint32_t kAvrCyclesPerLine = 430776;
+constexpr std::uint32_t kAvrCyclesPerHullTest = 19982;
+
+DeviceCost DeviceCost::Atmega2560() {
+  return DeviceCost{16'000'000, kAvrCyclesPerLine, kAvrCyclesPerHullTest};
+}
+
+std::uint64_t DeviceCost::Microseconds(const motion::ValidationWork& work) const {
+  if (cpu_hz == 0) return 0;
+  const std::uint64_t cycles = std::uint64_t{work.lines} * cycles_per_line +
+                               std::uint64_t{work.hull_tests} * cycles_per_hull_test;
+  return (cycles * 1'000'000 + cpu_hz - 1) / cpu_hz;
+}
 
 SimulatedPlotter::SimulatedPlotter(const PlotterOptions& options)
     : options_(options),
@@ -180,6 +218,8 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
   HostSide host(link_.host(), options_.to_device, options_.fault_seed, tick_us);
   bool device_down = false;
   std::uint64_t next_progress = progress_interval_us;
+  std::uint64_t busy_until = 0;  // the device's main loop computes until then
+  motion::ValidationWork charged = runner_->validation_work();
 
   RunResult result;
   for (;;) {
@@ -194,13 +234,26 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
 
     host.Service(link, now);
 
-    // The device: its main loop, then one tick of its step timer.
-    if (device_down) {
-      device_down = device_end_->Reconnect(0) != hal::IoStatus::kOk;
-    } else {
-      device_down = runner_->Service(*device_end_) == hal::IoStatus::kDisconnected;
+    // The device: its main loop (unless still busy validating), then one
+    // tick of its step timer, an interrupt that a busy main loop does not stop.
+    if (now >= busy_until) {
+      if (device_end_->Release() == hal::IoStatus::kDisconnected) device_down = true;
+      if (device_down) {
+        device_down = device_end_->Reconnect(0) != hal::IoStatus::kOk;
+      } else {
+        device_end_->Hold();
+        device_down = runner_->Service(*device_end_) == hal::IoStatus::kDisconnected;
+        const motion::ValidationWork work = runner_->validation_work();
+        const motion::ValidationWork spent{work.lines - charged.lines,
+                                           work.hull_tests - charged.hull_tests};
+        charged = work;
+        busy_until = now + options_.device_cost.Microseconds(spent);
+        if (busy_until == now && device_end_->Release() == hal::IoStatus::kDisconnected) {
+          device_down = true;
+        }
+      }
+      if (now >= busy_until) runner_->Fill();
     }
-    runner_->Fill();
     (void)runner_->Tick(steps_, pen_);  // a failed output faults the device: the host sees kFault
     clock_.Advance(tick_us);
 

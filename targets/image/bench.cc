@@ -4,6 +4,10 @@
 #include "port.h"
 #include "report.h"
 
+#if FDSURF_IMAGE_SETUP
+#include "fdsurf/motion/path_generator.h"
+#endif
+
 namespace fdsurf {
 namespace image {
 namespace {
@@ -319,6 +323,72 @@ __attribute__((noinline)) void BenchAdaptive(const BenchSource& source) {
   BenchEngineAdaptive(curve);
 }
 
+#if FDSURF_IMAGE_SETUP
+// The device's validation on arrival (motion::ValidateCommand), its worst
+// cases: a PATCH frame whose every line's hull crosses the travel (x rises
+// and falls along one parameter, y along the other: control points at
+// 20 000 steps, lines below 15 250, travel 16 000), and one CURVE grazing the
+// edge, which takes many hull tests.
+// "points" is the lines planned, "acc" the hull tests.
+protocol::MachineConfig g_validate_config;
+protocol::Command g_validate_command;
+
+__attribute__((noinline)) void BenchValidateOne(const char* name) {
+  motion::ValidationWork work = {0, 0};
+  uint8_t detail = 0;
+  PortMark();
+  const protocol::ErrorCode error =
+      motion::ValidateCommand<2>(g_validate_command, g_validate_config, &detail, &work);
+  PortMark();
+  if (error != protocol::ErrorCode::kNone) PortExit(5);
+  PutBenchLine(name, 2, work.lines, work.hull_tests);
+}
+
+__attribute__((noinline)) void BenchValidate() {
+  protocol::MachineConfig& config = g_validate_config;
+  config = protocol::MachineConfig();
+  config.axes = 2;
+  config.travel_steps[0] = config.travel_steps[1] = 16000;
+  config.max_rate = 8000;
+  config.accel = 160000;
+  const int32_t bump[4] = {1000, 20000, 20000, 1000};
+  protocol::Command& command = g_validate_command;
+  command = protocol::Command();
+  command.type = protocol::MessageType::kPatch;
+  protocol::PatchCommand& patch = command.body.patch;
+  patch.basis = Basis::kBezier;
+  patch.dims = 2;
+  patch.tolerance_q8 = 512;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      patch.geometry[0].g[i][j] = GeometryFixed::FromRaw(int64_t{bump[j]} * 65536);
+      patch.geometry[1].g[i][j] = GeometryFixed::FromRaw(int64_t{bump[i]} * 65536);
+    }
+  }
+  patch.lines_s = patch.lines_t = kBenchValidateLines;
+  BenchValidateOne(FDSURF_TEXT("validate-frame"));
+  // y = T + (0, 17 142, 64 269, 0) · 2^-16 steps in Bézier form: its top is
+  // 0.22 · 2^-16 step inside T + 1/2; 19 hull tests, the most of 3000
+  // random grazes scaled to within 2^-16 step of the edge.
+  command = protocol::Command();
+  command.type = protocol::MessageType::kCurve;
+  protocol::CurveCommand& curve = command.body.curve;
+  curve.basis = Basis::kBezier;
+  curve.dims = 2;
+  curve.tolerance_q8 = 512;
+  const int64_t graze[4] = {0, 17142, 64269, 0};
+  for (int k = 0; k < 4; ++k) {
+    curve.geometry[0].g[k] = GeometryFixed::FromRaw((int64_t{1000} + 4000 * k) * 65536);
+    curve.geometry[1].g[k] = GeometryFixed::FromRaw(int64_t{16000} * 65536 + graze[k]);
+  }
+  BenchValidateOne(FDSURF_TEXT("validate-graze"));
+  // The same line with room to spare: the planner alone, no hull test, so
+  // the difference is the 19 hull tests.
+  config.travel_steps[1] = 17000;
+  BenchValidateOne(FDSURF_TEXT("validate-inside"));
+}
+#endif
+
 void RunBench(const BenchSource& source) {
 #if FDSURF_IMAGE_SETUP
   if (source.measure_setup) BenchSetup();
@@ -330,6 +400,9 @@ void RunBench(const BenchSource& source) {
   if (source.patch3 != nullptr) BenchPatch3(source);
 #endif
   BenchAdaptive(source);
+#if FDSURF_IMAGE_SETUP
+  BenchValidate();
+#endif
 }
 
 }  // namespace image

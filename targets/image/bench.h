@@ -25,6 +25,10 @@ constexpr uint16_t kBenchWideSteps = 4096;
 constexpr uint16_t kBenchGrid = 16;
 /// The teapot patch of the patch benches (a body patch).
 constexpr int kBenchTeapotPatch = 5;
+/// Lines per family of the validation bench's PATCH frame. A frame may ask
+/// for 1025; the cost is the same for every line of this frame, and 1025
+/// takes simavr over 4 minutes (docs/motion.md quotes both).
+constexpr uint16_t kBenchValidateLines = 65;
 
 /// The bench curve: a cubic Bézier about 60 mm long at Q = 1 µm (quanta), in
 /// raw GeometryFixed units. `wide` scales it to about 2^27 quanta, where the

@@ -282,6 +282,36 @@ TEST_F(Cli, StreamDrawsOnTheSimulatedPlotterAndReports) {
   EXPECT_EQ(lossy.err.find(" 0 resent"), std::string::npos) << lossy.err;
 }
 
+// Issue 12, defect 1: two patches 70 m apart at 1 µm steps were sent, and
+// the device faulted mid-job with an undecoded "detail 4" (exit 3). Now the
+// host refuses the job before sending anything (exit 2), in millimetres.
+TEST_F(Cli, StreamRefusesATravelTooLongForTheDeviceBeforeSendingAnything) {
+  std::ifstream in(kTeapot);
+  std::string count;
+  std::string line;
+  std::getline(in, count);
+  std::string patch;
+  for (int k = 0; k < 17 && std::getline(in, line); ++k) patch += line + "\n";
+  std::string far;
+  std::istringstream rows(patch);
+  std::getline(rows, line);
+  far += line + "\n";
+  while (std::getline(rows, line)) {
+    std::istringstream xyz(line);
+    double x = 0, y = 0, z = 0;
+    xyz >> x >> y >> z;
+    far += std::to_string(x + 70000) + " " + std::to_string(y) + " " + std::to_string(z) + "\n";
+  }
+  const std::string file = Write("far.bpt", "2\n" + patch + far);
+  const RunResult r = Run("stream '" + file +
+                          "' --fit none --view top --step 0.001 --speed 10 --accel 100 --lines 2");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("is more than the device can travel: at most 67108864 steps of 0.001 mm"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("frames sent"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   ExpectRefused("stream '" + kTeapot + "' --device serial", "--device: 'serial' is not sim");
   ExpectRefused("stream '" + kTeapot + "' --device usb --faults 0.1",

@@ -409,7 +409,7 @@ TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {
   EXPECT_EQ(detail, 1);
   // A curve that dips below y = 0 is refused; one whose control points lie
   // below 0 but whose curve stays above is accepted: the hull test alone
-  // would refuse it, the dry run of its points decides.
+  // would refuse it, halving the hull decides.
   protocol::Command curve;
   curve.type = protocol::MessageType::kCurve;
   curve.body.curve.basis = Basis::kBezier;
@@ -444,6 +444,120 @@ TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {
   EXPECT_EQ(motion::ValidateCommand<2>(move, Config(1200), &detail),
             protocol::ErrorCode::kOutOfTravel);
   EXPECT_EQ(detail, 0);
+}
+
+// Every straight move between two points of the largest travel the device
+// accepts is planned by the engine: the execution of a move (and the travel
+// before a line) can never be refused, wherever the machine is.
+TEST(ValidateCommand, EveryMoveInsideTheLargestTravelIsPlannable) {
+  const std::int64_t t = std::int64_t{motion::kMaxPlannableTravelSteps} << 16;
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = motion::kLineToleranceQ8;
+  const auto line = [](std::int64_t from, std::int64_t to) {
+    PowerCurve1 axis{};
+    axis.c[2] = to - from;
+    axis.c[3] = from;
+    return axis;
+  };
+  PreparedAdaptiveCurve<3> prepared3;
+  PreparedAdaptiveCurve<2> prepared2;
+  for (const auto& [from, to] : {std::pair{t, std::int64_t{0}}, std::pair{std::int64_t{0}, t}}) {
+    PowerCurve1 curve3[3] = {line(from, to), line(from, to), line(from, to)};
+    EXPECT_EQ(PrepareAdaptiveCurve(curve3, settings, &prepared3), Status::kOk);
+    PowerCurve1 curve2[2] = {line(from, to), line(to, from)};
+    EXPECT_EQ(PrepareAdaptiveCurve(curve2, settings, &prepared2), Status::kOk);
+  }
+  // One step more and the engine refuses: the cap is where it has to be.
+  PowerCurve1 longer[2] = {line(t + 65536, 0), line(0, 0)};
+  EXPECT_EQ(PrepareAdaptiveCurve(longer, settings, &prepared2), Status::kPrecisionUnreachable);
+  // Beyond the cap nothing is accepted against such a configuration.
+  protocol::MachineConfig config = Config(motion::kMaxPlannableTravelSteps + 1);
+  protocol::Command move;
+  move.type = protocol::MessageType::kMove;
+  move.body.move.target[0] = 1;
+  move.body.move.target[1] = 1;
+  std::uint8_t detail = 9;
+  EXPECT_EQ(motion::ValidateCommand<2>(move, config, &detail), protocol::ErrorCode::kOutOfTravel);
+  EXPECT_EQ(detail, 0);
+}
+
+// The travel check is sound and nearly exact: random cubics against an
+// exact dense evaluation. Never accepted when the curve reaches
+// travel + 1/2 (or −1/2); always accepted when it stays 1/16 step inside.
+TEST(ValidateCommand, TheTravelCheckIsSoundAndNearlyExact) {
+  std::mt19937_64 random(12);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  constexpr std::int32_t kTravel = 16000;
+  const protocol::MachineConfig config = Config(kTravel);
+  int accepted = 0;
+  int refused = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    protocol::Command curve;
+    curve.type = protocol::MessageType::kCurve;
+    curve.body.curve = protocol::CurveCommand{};
+    curve.body.curve.basis = Basis::kBezier;
+    curve.body.curve.dims = 2;
+    curve.body.curve.tolerance_q8 = 512;
+    const double spread = trial % 3 == 0 ? 30 : trial % 3 == 1 ? 3000 : 20000;
+    for (int i = 0; i < 4; ++i) {
+      curve.body.curve.geometry[0].g[i] = GeometryFixed::FromRaw(
+          std::llround((kTravel / 2 + 0.4 * kTravel * unit(random)) * 65536));
+      // y near the top: control points above it, the curve near it.
+      const bool inner = i == 1 || i == 2;
+      const double y = kTravel + spread * (inner ? 0.4 * unit(random) : -0.5 + 0.3 * unit(random));
+      curve.body.curve.geometry[1].g[i] = GeometryFixed::FromRaw(std::llround(y * 65536));
+    }
+    PowerCurve1 power[2];
+    CurveGeometry1 geometry[2] = {curve.body.curve.geometry[0], curve.body.curve.geometry[1]};
+    ASSERT_EQ(CurvePowerCoefficients(geometry, Basis::kBezier, power), Status::kOk);
+    long double low = 1e30L;
+    long double high = -1e30L;
+    for (int k = 0; k <= 20000; ++k) {
+      const long double y = Evaluate(power[1], k / 20000.0L);
+      low = std::min(low, y);
+      high = std::max(high, y);
+    }
+    std::uint8_t detail = 0;
+    const protocol::ErrorCode error = motion::ValidateCommand<2>(curve, config, &detail);
+    if (high >= kTravel + 0.5L || low < -0.5L) {
+      EXPECT_EQ(error, protocol::ErrorCode::kOutOfTravel) << trial << " reaches " << high;
+    } else if (high < kTravel + 0.5L - 1.0L / 16) {
+      EXPECT_EQ(error, protocol::ErrorCode::kNone) << trial << " stays below " << high;
+    }
+    (error == protocol::ErrorCode::kNone ? accepted : refused) += 1;
+  }
+  EXPECT_GT(accepted, 100);
+  EXPECT_GT(refused, 100);
+}
+
+// Defect 2 of issue 12: a 1025×1025-line frame whose every inner line's hull
+// crosses the travel took seconds, stepping every point. Its validation now
+// has a fixed bound per line, counted here (not timed).
+TEST(ValidateCommand, AFrameOf1025LinesValidatesWithinItsBudget) {
+  // x rises and falls along one parameter, y along the other: every line's
+  // control points reach 20 000, every line stays below 15 250.
+  protocol::Command patch = BumpPatch(100, 1000, 0, 1025);
+  const double bump[4] = {1000, 20000, 20000, 1000};
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      patch.body.patch.geometry[0].g[i][j] = GeometryFixed::FromRaw(std::llround(bump[j] * 65536));
+      patch.body.patch.geometry[1].g[i][j] = GeometryFixed::FromRaw(std::llround(bump[i] * 65536));
+    }
+  }
+  const protocol::MachineConfig config = Config(16000);
+  motion::ValidationWork work{0, 0};
+  std::uint8_t detail = 0;
+  EXPECT_EQ(motion::ValidateCommand<2>(patch, config, &detail, &work), protocol::ErrorCode::kNone)
+      << int{detail};
+  EXPECT_EQ(work.lines, 2u * 1025u);
+  // The documented bound: kDims · kHullTestBudget hull tests per line.
+  EXPECT_LE(work.hull_tests, work.lines * 2u * motion::kHullTestBudget);
+  // In fact a few per crossing line (docs/motion.md quotes this figure).
+  EXPECT_GT(work.hull_tests, 1000u);  // the hull does cross: the test is not vacuous
+  EXPECT_LE(work.hull_tests, work.lines * 40u);
+  RecordProperty("hull_tests", static_cast<int>(work.hull_tests));
+  std::printf("frame of 1025x1025 lines: %u lines, %u hull tests\n", work.lines, work.hull_tests);
 }
 
 // --- The device ------------------------------------------------------------
@@ -498,6 +612,15 @@ TEST_F(DeviceTest, RefusesMotionBeforeConfigurationAndConfigurationsItCannotServ
   config.body.config.accel = 1;
   EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kBadField);
   EXPECT_EQ(detail, protocol::kConfigFieldAccel);
+  // Issue 12, defect 1: a travel whose moves the engine cannot plan (70 m at
+  // 1 µm steps) was accepted, and a long move then faulted the device.
+  config = Configure(70'000'000);
+  EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kBadField);
+  EXPECT_EQ(detail, protocol::kConfigFieldTravel);
+  config = Configure(motion::kMaxPlannableTravelSteps);
+  config.body.config.travel_steps[1] = motion::kMaxPlannableTravelSteps + 1;
+  EXPECT_EQ(Accept(config, &detail), protocol::ErrorCode::kBadField);
+  EXPECT_EQ(detail, protocol::kConfigFieldTravel + 1);
   EXPECT_EQ(device_.Credits(), 4);  // nothing was queued
 }
 

@@ -10,8 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/sim/checks.h"
 #include "fdsurf/sim/plotter.h"
 
@@ -126,6 +128,114 @@ TEST(CheckMotion, CatchesEveryKindOfViolation) {
   // A step 2 ms after a pen change with a 10 ms pen delay.
   const std::vector<hal::PenEvent> pen = {{good[150].time_us - 2000, true}};
   EXPECT_GT(CheckMotion(good, pen, limits).violations, 0u);
+}
+
+// Issue 12, defect 3: at a 0.1 mm margin the device refused patch 31 (its
+// bottom reached 0.8 steps below the page) after 7 patches were drawn: the
+// host's fit had missed the extremum of a line whose cubic term is rounding
+// noise. Now the fit is right, the drawing fits, and the host asks the
+// device's own validation about every command before sending any.
+TEST(BuildStreamJob, TheTeapotAtATenthOfAMillimetreMarginFitsTheDevice) {
+  host::ToolpathOptions options;  // as `fdsurf stream examples/teapot.bpt --margin 0.1`
+  options.view = *host::NamedView("iso");
+  options.fit = std::array<double, 2>{200, 150};
+  options.margin = 0.1;
+  options.lines_s = 8;
+  options.lines_t = 8;
+  options.tolerance = 0.05;
+  options.mode = host::StepMode::kStepExact;
+  const host::StreamJob job = host::BuildStreamJob(Teapot(), options, host::MachineOptions{}, "mm");
+  ASSERT_EQ(job.config.travel_steps[1], 12000);
+  for (std::size_t k = 0; k < job.commands.size(); ++k) {
+    std::uint8_t detail = 0;
+    EXPECT_EQ(motion::ValidateCommand<2>(job.commands[k], job.config, &detail),
+              protocol::ErrorCode::kNone)
+        << job.labels[k] << " detail " << int{detail};
+  }
+}
+
+// Issue 12, defect 1: two patches 70 m apart at 1 µm steps need a travel the
+// device cannot move in one straight line (2^26 steps); the job was sent and
+// the device faulted mid-job. The host refuses it before sending anything,
+// in millimetres.
+TEST(BuildStreamJob, RefusesATravelTheDeviceCannotMove) {
+  host::PatchSet far;
+  far.patches.push_back(Teapot().patches[0]);
+  far.patches.push_back(Teapot().patches[0]);
+  for (auto& row : far.patches[1].g) {
+    for (auto& point : row) point[0] += 70000;
+  }
+  host::ToolpathOptions options;
+  options.view = *host::NamedView("top");
+  options.lines_s = 2;
+  options.lines_t = 2;
+  options.tolerance = 0.005;
+  options.mode = host::StepMode::kStepExact;
+  host::MachineOptions machine;
+  machine.step = host::Quantum::Parse("0.001");
+  machine.speed = 10;
+  machine.accel = 100;
+  try {
+    (void)host::BuildStreamJob(far, options, machine, "mm");
+    FAIL() << "accepted a travel of more than 2^26 steps";
+  } catch (const host::OptionError& error) {
+    EXPECT_EQ(error.field(), "travel X");
+    EXPECT_NE(error.problem().find("67108.9 mm"), std::string::npos) << error.what();
+  }
+  // Inside the cap the same pair is accepted, every command as the device will.
+  for (auto& row : far.patches[1].g) {
+    for (auto& point : row) point[0] -= 10000;
+  }
+  const host::StreamJob job = host::BuildStreamJob(far, options, machine, "mm");
+  EXPECT_LE(job.config.travel_steps[0], motion::kMaxPlannableTravelSteps);
+}
+
+// Issue 12, defect 2: the simulator's time stood still while the device
+// computed, so a slow validation never showed. With the ATmega2560's cost
+// model a 1025×1025-line PATCH keeps the device's main loop busy for
+// seconds of virtual time: the host sees no answer and times out.
+TEST(SimulatedPlotter, ChargesTheDevicesComputeTime) {
+  protocol::Command config;
+  config.type = protocol::MessageType::kConfig;
+  config.seq = 0;
+  config.body.config = protocol::MachineConfig{};
+  config.body.config.axes = 2;
+  config.body.config.steps_per_meter[0] = config.body.config.steps_per_meter[1] = 80000;
+  config.body.config.travel_steps[0] = config.body.config.travel_steps[1] = 100;
+  config.body.config.max_rate = 8000;
+  config.body.config.accel = 160000;
+  protocol::Command patch;
+  patch.type = protocol::MessageType::kPatch;
+  patch.seq = 0;
+  patch.body.patch = protocol::PatchCommand{};
+  patch.body.patch.basis = Basis::kBezier;
+  patch.body.patch.dims = 2;
+  patch.body.patch.lines_s = patch.body.patch.lines_t = 1025;
+  patch.body.patch.tolerance_q8 = 512;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {  // a 6×6-step square
+      patch.body.patch.geometry[0].g[i][j] = GeometryFixed::FromRaw((10 + 2 * j) * 65536);
+      patch.body.patch.geometry[1].g[i][j] = GeometryFixed::FromRaw((10 + 2 * i) * 65536);
+    }
+  }
+  const auto run = [&](const DeviceCost& cost) {
+    PlotterOptions options;
+    options.device_cost = cost;
+    SimulatedPlotter plotter(options);
+    host::HostLink link;
+    EXPECT_TRUE(link.Enqueue(config, "config").ok());
+    EXPECT_TRUE(link.Enqueue(patch, "patch").ok());
+    return plotter.Run(link, 600ull * 1'000'000);
+  };
+  const RunResult free = run(DeviceCost{});
+  ASSERT_TRUE(free.finished) << free.error;
+  EXPECT_EQ(free.host.timeouts, 0u);
+  const DeviceCost avr = DeviceCost::Atmega2560();
+  const std::uint64_t busy_us = avr.Microseconds(motion::ValidationWork{2050, 3 * 2050});
+  EXPECT_GT(busy_us, 1'000'000u);  // seconds on the Mega
+  const RunResult slow = run(avr);
+  EXPECT_GT(slow.host.timeouts, 0u);
+  if (slow.finished) EXPECT_GE(slow.acknowledged_us, free.acknowledged_us + busy_us);
 }
 
 TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {

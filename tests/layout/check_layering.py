@@ -61,8 +61,10 @@ ALLOWED = {
     "host-constructions": {"engine", "host-core", "host-reference"},
     "host-formats": {"engine", "host-core", "host-reference", "host-constructions"},
     "host-toolpath": {"engine", "host-core", "host-reference", "host-constructions"},
-    "host-stream": {"engine", "protocol", "host-core", "host-reference", "host-constructions",
-                    "host-toolpath"},
+    # host-stream asks the device's own validation (motion::ValidateCommand)
+    # about every command before a job is sent.
+    "host-stream": {"engine", "protocol", "motion", "host-core", "host-reference",
+                    "host-constructions", "host-toolpath"},
     "host-link": {"engine", "protocol"},
     "sim": CORE | {"hal-sim", "host-link"},
     "tools": set(BOXES),

@@ -40,75 +40,164 @@ bool IsPoint(const PowerCurve1 (&curve)[kDims]) {
   return true;
 }
 
-// Whether every point the stepper can emit for this curve surely lies in
-// [0, travel] on every axis: the curve stays in the convex hull of its
-// Bernstein coefficients b0..b3, and a value in [−1/2, T + 1/2) rounds into
-// [0, T]. Tested as 3·b_i, which are integers: 3d, 3d + c, 3d + 2c + b,
-// 3(a + b + c + d). Coefficients are below 2^54, so nothing overflows.
-template <int kDims>
-bool WithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel, uint8_t* axis) {
-  for (int c = 0; c < kDims; ++c) {
-    const int64_t a = curve[c].c[0];
-    const int64_t b = curve[c].c[1];
-    const int64_t cc = curve[c].c[2];
-    const int64_t d = curve[c].c[3];
-    const int64_t hull[4] = {3 * d, 3 * d + cc, 3 * d + 2 * cc + b, 3 * (a + b + cc + d)};
-    const int64_t low = -3 * kHalfStep;
-    const int64_t high = 3 * (static_cast<int64_t>(travel[c]) * kOneStep + kHalfStep);
-    for (const int64_t value : hull) {
-      if (value < low || value >= high) {
-        *axis = static_cast<uint8_t>(c);
-        return false;
-      }
-    }
-  }
-  return true;
+// 3·low and 3·high: a value in [−1/2, T + 1/2) rounds into [0, T].
+constexpr int64_t kLow3 = -3 * kHalfStep;
+int64_t High3(int32_t travel) { return 3 * (static_cast<int64_t>(travel) * kOneStep + kHalfStep); }
+
+Int128 Widen(int64_t v) {
+  return Int128{static_cast<uint64_t>(v), v < 0 ? ~uint64_t{0} : uint64_t{0}};
 }
 
-// Steps the prepared curve exactly as execution will, checking every point.
-template <typename Acc, int kDims>
-bool PointsWithinTravel(const PreparedAdaptiveCurve<kDims>& prepared, const int32_t* travel,
-                        uint8_t* axis) {
-  AdaptiveCurveCursor<Acc, kDims> cursor(prepared);
-  int32_t point[kDims];
-  uint32_t position = 0;
-  while (cursor.Next(point, &position)) {
-    for (int c = 0; c < kDims; ++c) {
-      if (point[c] < 0 || point[c] > travel[c]) {
-        *axis = static_cast<uint8_t>(c);
+// The cubic A·s³ + B·s² + C·s + D of one piece [j·2^-k, (j+1)·2^-k] of a
+// line's axis, in the piece's own parameter s ∈ [0, 1], in units of
+// 2^-(16+3k) steps: every coefficient is an integer, and every move between
+// neighbouring pieces is additions and exact shifts.
+struct Piece {
+  Int128 a, b, c, d;
+};
+
+enum class Hull : uint8_t { kInside, kOutside, kCrossing };
+
+bool InRange(const Int128& value, const Int128& low3, const Int128& high3) {
+  return low3 <= value && !(high3 <= value);
+}
+
+// The piece's Bernstein coefficients, times 3: 3D, 3D + C, 3D + 2C + B,
+// 3(A + B + C + D). The first and last are points of the curve: outside
+// means the line leaves the travel.
+Hull Classify(const Piece& p, const Int128& low3, const Int128& high3) {
+  const Int128 d3 = p.d + p.d + p.d;
+  const Int128 sum = p.a + p.b + p.c + p.d;
+  if (!InRange(d3, low3, high3) || !InRange(sum + sum + sum, low3, high3)) return Hull::kOutside;
+  const Int128 h1 = d3 + p.c;
+  return InRange(h1, low3, high3) && InRange(h1 + p.c + p.b, low3, high3) ? Hull::kInside
+                                                                          : Hull::kCrossing;
+}
+
+// The left half, rescaled: p(s/2)·8 = A, 2B, 4C, 8D.
+void ToLeftHalf(Piece* p) {
+  p->b = internal::ShiftLeft(p->b, 1);
+  p->c = internal::ShiftLeft(p->c, 2);
+  p->d = internal::ShiftLeft(p->d, 3);
+}
+
+// From a left half to its right neighbour at the same scale: p(s + 1).
+void ToRightNeighbour(Piece* p) {
+  const Int128 a3 = p->a + p->a + p->a;
+  p->d = p->d + p->c + p->b + p->a;
+  p->c = p->c + p->b + p->b + a3;
+  p->b = p->b + a3;
+}
+
+// From a right half back to the whole piece it is half of: p(s − 1) is the
+// left half, and the left half divided back (exactly: it was multiplied).
+void ToParent(Piece* p) {
+  const Int128 a3 = p->a + p->a + p->a;
+  p->d = p->d - p->c + p->b - p->a;
+  p->c = p->c - p->b - p->b + a3;
+  p->b = p->b - a3;
+  p->b = internal::ShiftRightArithmetic(p->b, 1);
+  p->c = internal::ShiftRightArithmetic(p->c, 2);
+  p->d = internal::ShiftRightArithmetic(p->d, 3);
+}
+
+// Whether the cubic a·u³ + b·u² + c·u + d (2^-16 steps) stays in
+// [−1/2, T + 1/2) for u ∈ [0, 1]: pieces whose hull crosses the boundary are
+// halved, depth first, in exact integers, until every hull is inside
+// (accepted) or a curve point is outside (refused: exact). A piece still
+// crossing at kHullMaxDepth, or a line needing more than kHullTestBudget
+// tests, is refused too (*undecided): never accepted unless proven inside.
+// Coefficients below 2^49 times 8^20 stay below 2^113: no overflow.
+bool AxisWithinTravel(const int64_t (&k)[4], int32_t travel, ValidationWork* work,
+                      bool* undecided) {
+  Piece p{Widen(k[0]), Widen(k[1]), Widen(k[2]), Widen(k[3])};
+  Int128 low3 = Widen(kLow3);
+  Int128 high3 = Widen(High3(travel));
+  uint32_t j = 0;
+  int depth = 0;
+  for (uint16_t tests = 0;; ++tests) {
+    if (tests == kHullTestBudget) {
+      *undecided = true;
+      return false;
+    }
+    if (work != nullptr) ++work->hull_tests;
+    const Hull hull = Classify(p, low3, high3);
+    if (hull == Hull::kOutside) return false;
+    if (hull == Hull::kCrossing) {
+      if (depth == kHullMaxDepth) {
+        *undecided = true;
         return false;
       }
+      ToLeftHalf(&p);
+      low3 = internal::ShiftLeft(low3, 3);
+      high3 = internal::ShiftLeft(high3, 3);
+      ++depth;
+      j <<= 1;
+      continue;
+    }
+    while ((j & 1u) != 0) {  // a right half is done: so is its parent
+      ToParent(&p);
+      low3 = internal::ShiftRightArithmetic(low3, 3);
+      high3 = internal::ShiftRightArithmetic(high3, 3);
+      --depth;
+      j >>= 1;
+    }
+    if (depth == 0) return true;
+    ToRightNeighbour(&p);
+    ++j;
+  }
+}
+
+// Whether every point the stepper can emit for this curve lies in
+// [0, travel] on every axis. The curve stays in the convex hull of its
+// Bernstein coefficients b0..b3, and a value in [−1/2, T + 1/2) rounds into
+// [0, T]; tested as 3·b_i, which are integers: 3d, 3d + c, 3d + 2c + b,
+// 3(a + b + c + d). Almost every line passes this at once; an axis whose
+// hull crosses the boundary is decided by AxisWithinTravel. Coefficients
+// are below 2^49 (the planner checked), so nothing overflows.
+template <int kDims>
+bool WithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel, uint8_t* detail,
+                  ValidationWork* work) {
+  for (int c = 0; c < kDims; ++c) {
+    const int64_t(&k)[4] = curve[c].c;
+    const int64_t hull[4] = {3 * k[3], 3 * k[3] + k[2], 3 * k[3] + 2 * k[2] + k[1],
+                             3 * (k[0] + k[1] + k[2] + k[3])};
+    bool crossing = false;
+    for (const int64_t value : hull)
+      crossing = crossing || value < kLow3 || value >= High3(travel[c]);
+    if (!crossing) continue;
+    bool undecided = false;
+    if (!AxisWithinTravel(k, travel[c], work, &undecided)) {
+      *detail = static_cast<uint8_t>(c | (undecided ? kUndecidedTravel : 0));
+      return false;
     }
   }
   return true;
 }
 
 // The planner must accept the line, and every point it will emit must lie
-// within the travel: the hull test decides at once for almost every line;
-// a line whose hull crosses the boundary is stepped through to decide.
+// within the travel.
 template <int kDims>
 ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8,
-                    const protocol::MachineConfig& config, uint8_t* detail) {
+                    const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
   AdaptiveSettings settings;
   settings.mode = AdaptiveMode::kStepExact;
   settings.tolerance_q8 = tolerance_q8;
   PreparedAdaptiveCurve<kDims> prepared;
+  if (work != nullptr) ++work->lines;
   const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
   if (status != Status::kOk) {
     *detail = static_cast<uint8_t>(status);
     return ErrorCode::kPlannerRefused;
   }
-  if (WithinTravel(curve, config.travel_steps, detail)) return ErrorCode::kNone;
-  const bool inside = prepared.format.acc_bits == 64
-                          ? PointsWithinTravel<int64_t>(prepared, config.travel_steps, detail)
-                          : PointsWithinTravel<Int128>(prepared, config.travel_steps, detail);
-  return inside ? ErrorCode::kNone : ErrorCode::kOutOfTravel;
+  return WithinTravel(curve, config.travel_steps, detail, work) ? ErrorCode::kNone
+                                                                : ErrorCode::kOutOfTravel;
 }
 
 template <int kDims>
 ErrorCode CheckFamily(const PatchGeometry1 (&geometry)[kDims], const protocol::PatchCommand& patch,
                       IsolineFamily family, uint16_t lines, const protocol::MachineConfig& config,
-                      uint8_t* detail) {
+                      uint8_t* detail, ValidationWork* work) {
   if (lines == 0) return ErrorCode::kNone;
   IsolineWalker<kDims> walker;
   const Status created =
@@ -121,7 +210,7 @@ ErrorCode CheckFamily(const PatchGeometry1 (&geometry)[kDims], const protocol::P
   for (uint16_t index = 0; walker.Next(curve); ++index) {
     if (IsPoint(curve) || Skipped(patch.skip_lines, family, index, lines)) continue;  // not drawn
     if ((index & 1u) != 0) ReverseCurve(curve);
-    const ErrorCode error = CheckLine(curve, patch.tolerance_q8, config, detail);
+    const ErrorCode error = CheckLine(curve, patch.tolerance_q8, config, detail, work);
     if (error != ErrorCode::kNone) return error;
   }
   return ErrorCode::kNone;
@@ -145,9 +234,37 @@ void ReverseCurve(PowerCurve1 (&curve)[kDims]) {
 }
 
 template <int kDims>
+bool TravelPlannable(const protocol::MachineConfig& config, uint8_t* axis) {
+  for (int c = 0; c < kDims; ++c) {
+    if (config.travel_steps[c] < 0 || config.travel_steps[c] > kMaxPlannableTravelSteps) {
+      *axis = static_cast<uint8_t>(c);
+      return false;
+    }
+  }
+  return true;
+}
+
+template <int kDims>
 ErrorCode ValidateCommand(const protocol::Command& command, const protocol::MachineConfig& config,
                           uint8_t* detail) {
+  return ValidateCommand<kDims>(command, config, detail, nullptr);
+}
+
+// Every straight move execution makes (a MOVE, the travel before a line)
+// goes from where the machine is to a point inside the travel. The machine
+// is only ever where an accepted command took it, inside a travel of at most
+// kMaxPlannableTravelSteps (TravelPlannable, also checked for each CONFIG),
+// so the move's coefficients are at most that on every axis, and the planner
+// accepts every such line (it is monotone in the coefficients' magnitudes;
+// ValidateCommand.EveryMoveInsideTheLargestTravelIsPlannable checks the
+// largest). So the start of a command needs no check of its own.
+template <int kDims>
+ErrorCode ValidateCommand(const protocol::Command& command, const protocol::MachineConfig& config,
+                          uint8_t* detail, ValidationWork* work) {
   *detail = 0;
+  if (command.type != MessageType::kConfig && !TravelPlannable<kDims>(config, detail)) {
+    return ErrorCode::kOutOfTravel;
+  }
   switch (command.type) {
     case MessageType::kPatch: {
       const protocol::PatchCommand& patch = command.body.patch;
@@ -155,9 +272,10 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
       PatchGeometry1 geometry[kDims];
       CopyGeometry(patch.geometry, geometry);
       const ErrorCode s_lines =
-          CheckFamily(geometry, patch, IsolineFamily::kSLines, patch.lines_s, config, detail);
+          CheckFamily(geometry, patch, IsolineFamily::kSLines, patch.lines_s, config, detail, work);
       if (s_lines != ErrorCode::kNone) return s_lines;
-      return CheckFamily(geometry, patch, IsolineFamily::kTLines, patch.lines_t, config, detail);
+      return CheckFamily(geometry, patch, IsolineFamily::kTLines, patch.lines_t, config, detail,
+                         work);
     }
     case MessageType::kCurve: {
       const protocol::CurveCommand& curve = command.body.curve;
@@ -170,7 +288,7 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
         *detail = static_cast<uint8_t>(status);
         return ErrorCode::kPlannerRefused;
       }
-      return CheckLine(power, curve.tolerance_q8, config, detail);
+      return CheckLine(power, curve.tolerance_q8, config, detail, work);
     }
     case MessageType::kMove:
       for (int c = 0; c < kDims; ++c) {
@@ -420,10 +538,16 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
 
 template void ReverseCurve<2>(PowerCurve1 (&)[2]);
 template void ReverseCurve<3>(PowerCurve1 (&)[3]);
+template bool TravelPlannable<2>(const protocol::MachineConfig&, uint8_t*);
+template bool TravelPlannable<3>(const protocol::MachineConfig&, uint8_t*);
 template ErrorCode ValidateCommand<2>(const protocol::Command&, const protocol::MachineConfig&,
                                       uint8_t*);
 template ErrorCode ValidateCommand<3>(const protocol::Command&, const protocol::MachineConfig&,
                                       uint8_t*);
+template ErrorCode ValidateCommand<2>(const protocol::Command&, const protocol::MachineConfig&,
+                                      uint8_t*, ValidationWork*);
+template ErrorCode ValidateCommand<3>(const protocol::Command&, const protocol::MachineConfig&,
+                                      uint8_t*, ValidationWork*);
 template class PathGenerator<2>;
 template class PathGenerator<3>;
 

@@ -12,6 +12,7 @@
 #include "fdsurf/host/plan.h"
 #include "fdsurf/host/reference.h"
 #include "fdsurf/host/text.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf::host {
@@ -52,10 +53,19 @@ std::array<Vec, 2> Ends(const Patch& patch, const StreamJob& job, int lines_s, i
 std::int32_t TravelSteps(double length, const Quantum& step, const std::string& units,
                          const std::string& field) {
   const double steps = std::floor(length / step.value() + 1e-9);
-  if (!(steps >= 1 && steps <= protocol::kMaxTravelSteps)) {
-    throw OptionError(
-        field, FormatNumber(length) + " " + units,
-        "is not 1.." + std::to_string(protocol::kMaxTravelSteps) + " steps of " + step.Format(1));
+  if (!(steps >= 1)) {
+    throw OptionError(field, FormatNumber(length) + " " + units,
+                      "is less than one step of " + step.Format(1) + " " + units);
+  }
+  // The device plans every straight move inside a travel of at most this
+  // many steps, and refuses a larger travel (motion::TravelPlannable).
+  constexpr std::int32_t kMost = motion::kMaxPlannableTravelSteps;
+  if (steps > kMost) {
+    throw OptionError(field, FormatNumber(length) + " " + units,
+                      "is more than the device can travel: at most " + std::to_string(kMost) +
+                          " steps of " + step.Format(1) + " " + units + " = " +
+                          FormatNumber(kMost * step.value()) + " " + units +
+                          " (use a coarser --step)");
   }
   return static_cast<std::int32_t>(steps);
 }
@@ -206,6 +216,120 @@ void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const Machi
   if (pen_down) pen(false);
 }
 
+const char* const kAxisNames[3] = {"X", "Y", "Z"};
+
+// The exact range (steps) of one axis of a line with integer power
+// coefficients in 2^-16 steps, from the ends and the derivative's roots.
+std::array<long double, 2> LineRange(const PowerCurve1& line) {
+  const long double a = line.c[0] / 65536.0L;
+  const long double b = line.c[1] / 65536.0L;
+  const long double c = line.c[2] / 65536.0L;
+  const long double d = line.c[3] / 65536.0L;
+  const auto f = [&](long double u) { return ((a * u + b) * u + c) * u + d; };
+  std::array<long double, 2> range{std::min(f(0), f(1)), std::max(f(0), f(1))};
+  const auto consider = [&](long double u) {
+    if (u > 0 && u < 1) range = {std::min(range[0], f(u)), std::max(range[1], f(u))};
+  };
+  const long double disc = 4 * b * b - 12 * a * c;
+  if (a == 0) {
+    if (b != 0) consider(-c / (2 * b));
+  } else if (disc >= 0) {
+    consider((-2 * b + std::sqrt(disc)) / (6 * a));
+    consider((-2 * b - std::sqrt(disc)) / (6 * a));
+  }
+  return range;
+}
+
+// The exact range, per axis, of the lines a PATCH or CURVE command draws,
+// as the device computes them (the same walker and coefficients), in steps.
+template <int kDims>
+std::array<std::array<long double, 2>, 3> CommandRange(const protocol::Command& command) {
+  std::array<std::array<long double, 2>, 3> range{};
+  for (auto& r : range) r = {HUGE_VALL, -HUGE_VALL};
+  const auto add = [&](const PowerCurve1(&line)[kDims]) {
+    for (int c = 0; c < kDims; ++c) {
+      const auto r = LineRange(line[c]);
+      range[c] = {std::min(range[c][0], r[0]), std::max(range[c][1], r[1])};
+    }
+  };
+  PowerCurve1 line[kDims];
+  if (command.type == protocol::MessageType::kCurve) {
+    CurveGeometry1 geometry[kDims];
+    for (int c = 0; c < kDims; ++c) geometry[c] = command.body.curve.geometry[c];
+    if (CurvePowerCoefficients(geometry, command.body.curve.basis, line) == Status::kOk) add(line);
+    return range;
+  }
+  const protocol::PatchCommand& patch = command.body.patch;
+  PatchGeometry1 geometry[kDims];
+  for (int c = 0; c < kDims; ++c) geometry[c] = patch.geometry[c];
+  for (const IsolineFamily family : {IsolineFamily::kSLines, IsolineFamily::kTLines}) {
+    const std::uint16_t lines = family == IsolineFamily::kSLines ? patch.lines_s : patch.lines_t;
+    IsolineWalker<kDims> walker;
+    if (lines < 2 || IsolineWalker<kDims>::Create(geometry, patch.basis, family, lines, &walker) !=
+                         Status::kOk) {
+      continue;
+    }
+    while (walker.Next(line)) add(line);
+  }
+  return range;
+}
+
+// The message for a command the device would refuse, in the user's units,
+// with the exact range of the command's lines for a travel refusal.
+template <int kDims>
+[[noreturn]] void ThrowRefusal(const StreamJob& job, std::size_t index, protocol::ErrorCode error,
+                               std::uint8_t detail) {
+  const protocol::Command& command = job.commands[index];
+  const double step = job.page.quantum.value();
+  const std::string units = " " + job.page.units;
+  std::string message = job.labels[index] + ": ";
+  if (error == protocol::ErrorCode::kPlannerRefused) {
+    message += StatusMessage(static_cast<Status>(detail));
+    message += " (the device's planner would refuse it); use a coarser step or a larger tolerance";
+    throw EngineError(message);
+  }
+  if (error != protocol::ErrorCode::kOutOfTravel) {
+    message += "the device would refuse it: ";
+    message += protocol::ErrorName(error);
+    throw EngineError(message);
+  }
+  const int axis = detail & 3;
+  const std::string travel =
+      "the travel 0.." + FormatNumber(job.config.travel_steps[axis] * step) + units;
+  if (command.type == protocol::MessageType::kMove) {
+    message += "the move to " + std::string(kAxisNames[axis]) + " = " +
+               FormatNumber(command.body.move.target[axis] * step) + units + " is outside " +
+               travel;
+    throw EngineError(message);
+  }
+  const auto range = CommandRange<kDims>(command)[static_cast<std::size_t>(axis)];
+  message += "its lines run over " + std::string(kAxisNames[axis]) + " = " +
+             FormatNumber(static_cast<double>(range[0]) * step) + ".." +
+             FormatNumber(static_cast<double>(range[1]) * step) + units;
+  if ((detail & motion::kUndecidedTravel) != 0) {
+    message += ", too close to the edge of " + travel +
+               " for the device to prove it inside; move it in by a step or two";
+  } else {
+    message += ", outside " + travel + " (points round to whole steps)";
+  }
+  throw EngineError(message);
+}
+
+// What the device will say to each command, asked of the device's own
+// validation (motion::ValidateCommand) with the configuration the job sends,
+// before anything is sent: a job that passes is never refused by the device
+// for its travel or its planner.
+template <int kDims>
+void CheckAsTheDeviceWill(const StreamJob& job) {
+  for (std::size_t i = 0; i < job.commands.size(); ++i) {
+    if (job.commands[i].type == protocol::MessageType::kConfig) continue;
+    std::uint8_t detail = 0;
+    const protocol::ErrorCode error =
+        motion::ValidateCommand<kDims>(job.commands[i], job.config, &detail);
+    if (error != protocol::ErrorCode::kNone) ThrowRefusal<kDims>(job, i, error, detail);
+  }
+}
+
 }  // namespace
 
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
@@ -243,6 +367,11 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
   }
   AddCurveCommands(set, t, machine, &job);
+  if (t.dims == 3) {
+    CheckAsTheDeviceWill<3>(job);
+  } else {
+    CheckAsTheDeviceWill<2>(job);
+  }
   return job;
 }
 

@@ -38,16 +38,16 @@ std::array<double, 2> CubicRange(double a, double b, double c, double d) {
       hi = std::max(hi, f(u));
     }
   };
+  // The roots of 3a·u² + 2b·u + c in the stable form q/qa and qc/q, with
+  // q = −(qb + sign(qb)·√disc)/2: the textbook (−qb ± √disc)/2qa cancels
+  // when a is tiny (a line whose cubic term is rounding noise, as on the
+  // teapot's bottom) and lost the extremum, 9 steps of it (issue 12).
   const double qa = 3 * a, qb = 2 * b, qc = c;
-  if (std::fabs(qa) < 1e-300) {
-    if (qb != 0) consider(-qc / qb);
-  } else {
-    const double disc = qb * qb - 4 * qa * qc;
-    if (disc >= 0) {
-      const double root = std::sqrt(disc);
-      consider((-qb + root) / (2 * qa));
-      consider((-qb - root) / (2 * qa));
-    }
+  const double disc = qb * qb - 4 * qa * qc;
+  if (disc >= 0) {
+    const double q = -(qb + std::copysign(std::sqrt(disc), qb)) / 2;
+    if (q != 0) consider(qc / q);
+    if (qa != 0) consider(q / qa);
   }
   return {lo, hi};
 }

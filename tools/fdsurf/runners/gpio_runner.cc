@@ -60,7 +60,7 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
     run(*device);
   }
   progress.Finish();
-  if (link.Failed()) throw DeviceError("gpio device: " + link.error());
+  if (link.Failed()) throw DeviceError("gpio device: " + DecodeDeviceError(link.error()));
   if (!o.quiet) {
     std::fprintf(stderr, "%s: %zu patches drawn on %s at %u Hz ticks\n", o.file.c_str(),
                  job.patches.size(), o.device.c_str(), tick_hz);

@@ -2,8 +2,11 @@
 #include "runner.h"
 
 #include <cstdio>
+#include <regex>
 
+#include "fdsurf/hal/io_status.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf::host {
@@ -24,6 +27,37 @@ void Enqueue(const StreamJob& job, HostLink* link) {
                         " (field " + std::to_string(result.field) + ", docs/protocol.md)");
     }
   }
+}
+
+// What a device error's detail number means, in words.
+std::string DetailInWords(const std::string& error, unsigned detail) {
+  using protocol::ErrorCode;
+  if (error == protocol::ErrorName(ErrorCode::kOutOfTravel) && (detail & 0x7Fu) < 3) {
+    const std::string axis = std::string("on ") + "XYZ"[detail & 3u];
+    return (detail & motion::kUndecidedTravel) != 0
+               ? axis + ": a line too close to the edge to prove inside (docs/motion.md)"
+               : axis;
+  }
+  if (error == protocol::ErrorName(ErrorCode::kPlannerRefused) && detail < 256) {
+    return StatusMessage(static_cast<Status>(detail));
+  }
+  if (error == protocol::ErrorName(ErrorCode::kOutputFailed) && detail < 256) {
+    return hal::IoStatusName(static_cast<hal::IoStatus>(detail));
+  }
+  if (error == protocol::ErrorName(ErrorCode::kDimsMismatch)) return "axis count";
+  return "detail " + std::to_string(detail);
+}
+
+std::string DecodeDeviceError(const std::string& message) {
+  static const std::regex kDetail("([a-z][a-z ]*[a-z]) \\(detail ([0-9]+)\\)");
+  std::string out;
+  auto begin = message.cbegin();
+  for (std::smatch m; std::regex_search(begin, message.cend(), m, kDetail); begin = m[0].second) {
+    out.append(begin, m[0].first);
+    out += m[1].str() + " (" + DetailInWords(m[1].str(), std::stoul(m[2].str())) + ")";
+  }
+  out.append(begin, message.cend());
+  return out;
 }
 
 // A device moves at most one step per axis per tick.

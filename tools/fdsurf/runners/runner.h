@@ -31,6 +31,10 @@ class DeviceError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A device error from the link with its "(detail N)" numbers in words
+/// ("out of travel (detail 1)" becomes "out of travel (on Y)").
+std::string DecodeDeviceError(const std::string& message);
+
 /// The link's settings for every runner.
 HostLinkOptions LinkOptions();
 

@@ -202,7 +202,7 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
   sim::SimulatedPlotter plotter(plotter_options);
   const sim::RunResult run = StreamToPlotter(o, job, &plotter);
-  if (!run.finished) throw DeviceError("sim device: " + run.error);
+  if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
   const CheckedDrawing checked = CheckDrawing(plotter, set, job, plotter_options.tick_hz, o.dims);
   WriteDrawing(o, job, checked.drawn);
   if (!o.quiet) PrintReport(o, set, job, drawing, units, plotter_options, run, checked);

@@ -54,7 +54,8 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
     }
   }
   progress.Finish();
-  if (link.Failed()) throw DeviceError(selector.ToString() + ": " + link.error());
+  if (link.Failed())
+    throw DeviceError(selector.ToString() + ": " + DecodeDeviceError(link.error()));
   if (!o.quiet) {
     std::fprintf(stderr, "%s: %zu patches drawn by usb %s; %llu frames sent (%llu resent)\n",
                  o.file.c_str(), job.patches.size(), selector.ToString().c_str(),

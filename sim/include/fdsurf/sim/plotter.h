@@ -14,6 +14,7 @@
 #include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/sim.h"
 #include "fdsurf/host/link.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/device_link.h"
 #include "fdsurf/sim/fault_link.h"
 
@@ -22,6 +23,21 @@ namespace fdsurf::sim {
 namespace internal {
 class DeviceRunner;  // the firmware Device for 2 or 3 axes
 }  // namespace internal
+
+/// The device's compute time, charged in virtual time: while the device
+/// validates the frames it has just read, its main loop is busy (its replies
+/// wait, nothing is read or expanded) and only the step timer, an
+/// interrupt, goes on. The time comes from the validation's counted work
+/// (motion::ValidationWork), so it is deterministic. cpu_hz = 0 (the
+/// default): computing is free, as on a fast host.
+struct DeviceCost {
+  std::uint32_t cpu_hz = 0;
+  std::uint32_t cycles_per_line = 0;       // planner and hull test of one line
+  std::uint32_t cycles_per_hull_test = 0;  // each halving's hull test
+  /// An ATmega2560 at 16 MHz, as measured under simavr (docs/motion.md).
+  static DeviceCost Atmega2560();
+  FDSURF_NODISCARD std::uint64_t Microseconds(const motion::ValidationWork& work) const;
+};
 
 struct PlotterOptions {
   /// 2 (pen plotter) or 3 (CNC with Z).
@@ -36,6 +52,8 @@ struct PlotterOptions {
   FaultRates to_device;
   FaultRates to_host;
   std::uint64_t fault_seed = 1;
+  /// What the device's validation costs in time (free by default).
+  DeviceCost device_cost;
 };
 
 /// Progress of a run: virtual time, commands acknowledged and executed.

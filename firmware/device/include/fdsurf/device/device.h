@@ -14,9 +14,11 @@
 //   device.Tick(steppers, pen);  // at most one unit move or pen change
 //
 // Commands are validated when they arrive (the engine's planner runs over
-// every line a patch will draw, and every point is checked against the
-// machine's travel), so execution never meets a refusal; a command that
-// would fail is answered with an ERROR and never queued.
+// every line a patch will draw, every line is checked against the machine's
+// travel, and the travel is capped so that every move between two points in
+// it is plannable), so execution never meets a refusal; a command that would
+// fail is answered with an ERROR and never queued. The validation's cost per
+// frame is bounded (motion::ValidateCommand, docs/motion.md).
 #pragma once
 
 #include <stddef.h>
@@ -148,6 +150,11 @@ class Device {
     return link_.frame_stats();
   }
   FDSURF_NODISCARD uint32_t executed() const { return executed_; }
+  /// The validation work done since construction (lines planned, hull
+  /// tests), for a simulator to charge as compute time.
+  FDSURF_NODISCARD const motion::ValidationWork& validation_work() const {
+    return validation_work_;
+  }
   FDSURF_NODISCARD bool Idle() const { return queued_ == 0 && generator_.Idle() && motion_.Idle(); }
 
   // --- The protocol sink (fdsurf/protocol/device_link.h) ------------------
@@ -167,12 +174,19 @@ class Device {
                                              : protocol::kConfigFieldAccel;
         return protocol::ErrorCode::kBadField;
       }
+      // A travel over kMaxPlannableTravelSteps would allow moves the engine
+      // cannot plan: refused here, so that no accepted move can fault.
+      uint8_t axis = 0;
+      if (!motion::TravelPlannable<kAxes>(config, &axis)) {
+        *detail = static_cast<uint8_t>(protocol::kConfigFieldTravel + axis);
+        return protocol::ErrorCode::kBadField;
+      }
       accepted_config_ = config;
       configured_ = true;
     } else {
       if (!configured_) return protocol::ErrorCode::kNotConfigured;
       const protocol::ErrorCode error =
-          motion::ValidateCommand<kAxes>(command, accepted_config_, detail);
+          motion::ValidateCommand<kAxes>(command, accepted_config_, detail, &validation_work_);
       if (error != protocol::ErrorCode::kNone) return error;
     }
     queue_[(queue_head_ + queued_) % kQueueCapacity] = command;
@@ -294,6 +308,7 @@ class Device {
   protocol::ErrorCode error_;
   uint8_t error_detail_;
   uint32_t executed_;
+  motion::ValidationWork validation_work_ = {0, 0};
 };
 
 }  // namespace device

@@ -27,16 +27,52 @@ namespace motion {
 /// error; only the step-exact limit matters).
 constexpr uint32_t kLineToleranceQ8 = 4 * 256;
 
+/// The largest travel (steps, per axis) a configuration may have: every
+/// straight move between two points of [0, 2^26] on every axis is planned
+/// by the engine (a longer one needs more than 128-bit accumulators), so
+/// with this cap no move execution makes can be refused.
+constexpr int32_t kMaxPlannableTravelSteps = int32_t{1} << 26;
+
+/// The travel check's bound per line and axis whose Bernstein hull crosses
+/// the boundary: halvings at most kHullMaxDepth deep, at most kHullTestBudget
+/// hull tests. A line that is not proven inside within it is refused with
+/// detail = axis | kUndecidedTravel (docs/motion.md, "Validation on arrival").
+constexpr int kHullMaxDepth = 20;
+constexpr uint16_t kHullTestBudget = 64;
+constexpr uint8_t kUndecidedTravel = 0x80;
+
+/// Work done by ValidateCommand, counted for tests and cost models: lines
+/// put through the planner, and hull tests of the travel check's halving.
+struct ValidationWork {
+  uint32_t lines;
+  uint32_t hull_tests;
+};
+
+/// Whether every axis's travel is at most kMaxPlannableTravelSteps; *axis =
+/// the first that is not.
+template <int kDims>
+bool TravelPlannable(const protocol::MachineConfig& config, uint8_t* axis);
+
 /// Checks, before a command is queued, everything that could make it fail or
 /// leave the machine's travel later: the engine's planner on every line it
-/// will step (so execution never meets a refusal), and that every point stays
-/// within [0, travel_steps] on every axis (each line's Bernstein coefficients,
-/// whose convex hull contains the line, must lie inside). Returns kNone, or
-/// kPlannerRefused with *detail = the fdsurf::Status, kOutOfTravel with
-/// *detail = the axis, kDimsMismatch.
+/// will step (so execution never meets a refusal; the straight moves between
+/// them are covered by kMaxPlannableTravelSteps), and that every point stays
+/// within [0, travel_steps] on every axis: each line must stay in
+/// [−1/2, travel + 1/2) on every axis, decided from its Bernstein hull,
+/// halved in exact integers where it crosses, within a fixed bound per line.
+/// Returns kNone, or kPlannerRefused with *detail = the fdsurf::Status,
+/// kOutOfTravel with *detail = the axis (| kUndecidedTravel when the bound
+/// ran out before deciding), kDimsMismatch. Worst case per frame: the
+/// planner on each of lines_s + lines_t lines plus kDims·kHullTestBudget
+/// hull tests each (docs/motion.md has it in cycles). `work`, if not null,
+/// is incremented by the work done.
 template <int kDims>
 protocol::ErrorCode ValidateCommand(const protocol::Command& command,
                                     const protocol::MachineConfig& config, uint8_t* detail);
+template <int kDims>
+protocol::ErrorCode ValidateCommand(const protocol::Command& command,
+                                    const protocol::MachineConfig& config, uint8_t* detail,
+                                    ValidationWork* work);
 
 /// Expands one command at a time into entries for the motion loop.
 template <int kDims>

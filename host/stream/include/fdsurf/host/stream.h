@@ -64,8 +64,14 @@ struct StreamJob {
 /// them stays short, and leaves out edge lines that an earlier patch draws
 /// already (patches of a surface share their edges: the teapot's 32 patches
 /// share 52). Throws OptionError ("lines", "tolerance", "fit", "travel X",
-/// "travel Y", "travel Z", "speed", "accel", "pen delay"), InputError (a
-/// file with nothing to draw) and EngineError (a patch out of range).
+/// "travel Y", "travel Z", "speed", "accel", "pen delay"; a travel over
+/// motion::kMaxPlannableTravelSteps, which the device refuses), InputError
+/// (a file with nothing to draw) and EngineError (a patch out of range).
+/// Before returning, every command is put through the device's own
+/// validation (motion::ValidateCommand) with the job's configuration: a job
+/// returned here is never refused by the device for its travel or planner;
+/// one that would be throws EngineError naming the command and its exact
+/// range in `units`.
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
                          const MachineOptions& machine, const std::string& units);
 
