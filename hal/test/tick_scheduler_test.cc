@@ -23,7 +23,7 @@ class FakeClock final : public Clock {
  public:
   FakeClock(std::uint64_t stall_at, std::uint64_t stall_us, std::uint64_t jitter_us = 0)
       : stall_at_(stall_at), stall_us_(stall_us), jitter_us_(jitter_us) {}
-  std::uint64_t sleeps() const { return sleeps_; }
+  FDSURF_NODISCARD std::uint64_t sleeps() const { return sleeps_; }
 
  private:
   std::uint64_t DoNowMicros() override { return now_; }

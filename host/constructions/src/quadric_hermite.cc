@@ -363,7 +363,7 @@ struct EdgePair {
     w = Cross(e, u);
   }
 
-  Point3 Direction(double theta) const {
+  FDSURF_NODISCARD Point3 Direction(double theta) const {
     return Add(Scale(u, std::cos(theta)), Scale(w, std::sin(theta)));
   }
 
@@ -371,7 +371,7 @@ struct EdgePair {
   // conics through a and b; they coincide when the coefficient vectors of
   // F restricted to the plane are proportional (seed 000: the plane through
   // the two shared vertices and a common point of both surfaces).
-  double Residual(double theta) const {
+  FDSURF_NODISCARD double Residual(double theta) const {
     const Point3 p = Direction(theta);
     const double c1[5] = {f1.Form(e, e), 2 * f1.Form(e, p), f1.Form(p, p), Dot(ga1, e),
                           Dot(ga1, p)};

@@ -36,12 +36,12 @@ class BptTokens {
     return std::string_view(text_).substr(start, pos_ - start);
   }
 
-  InputError Error(const std::string& what) const {
+  FDSURF_NODISCARD InputError Error(const std::string& what) const {
     return InputError(name_ + ":" + std::to_string(token_line_) + ": " + what);
   }
 
-  int line() const { return token_line_; }
-  const std::string& name() const { return name_; }
+  FDSURF_NODISCARD int line() const { return token_line_; }
+  FDSURF_NODISCARD const std::string& name() const { return name_; }
 
   double Number(const char* what) {
     const std::string_view token = Next();
