@@ -447,8 +447,8 @@ size_t HostLink::SendLimit() const {
   // After a timeout only the oldest frame goes (a probe): a window of patch
   // frames resent into a dead or lossy line is wasted; once the probe is
   // acknowledged, the rest follows (go-back-N from the device's next_seq).
-  return std::min<size_t>(
-      {queue_.size(), options_.window, credits_, probe_ ? size_t{1} : SIZE_MAX});
+  return std::min<size_t>({queue_.size(), options_.window, credits_,
+                           probe_ ? size_t{options_.timeout_resend_frames} : SIZE_MAX});
 }
 
 void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
@@ -484,7 +484,7 @@ void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
       return;
     }
     next_send_ = 0;
-    probe_ = true;
+    probe_ = options_.timeout_resend_frames != 0;
   }
   std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
   for (const size_t limit = SendLimit(); next_send_ < limit; ++next_send_) {
