@@ -113,7 +113,9 @@ class HostLink {
 
   /// Appends to `out` whatever should be sent now: HELLO until answered,
   /// retransmissions after a timeout or NAK, new commands within the window
-  /// and the device's credits, STOP, status queries.
+  /// and the device's credits, STOP, status queries. The Poll() that gives
+  /// up (Failed() afterwards) leaves STOP in `out`: write it before
+  /// checking Failed(), as every runner does.
   void Poll(uint64_t now_us, std::vector<uint8_t>* out);
 
   /// The earliest time at which Poll() will have something to do if no bytes
