@@ -331,17 +331,17 @@ size_t EncodeCommandBody(const Command& command, uint8_t* body, size_t capacity)
   return writer.Size();
 }
 
-size_t EncodeCommand(const Command& command, uint8_t* out, size_t capacity) {
+size_t EncodeCommand(const Command& command, uint8_t* out, size_t capacity, uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(command.type), command.seq);
+  encoder.Begin(static_cast<uint8_t>(command.type), command.seq, session);
   WriteCommandBody(command, &encoder);
   return encoder.Finish();
 }
 
 size_t EncodeFrame(MessageType type, uint16_t seq, const uint8_t* body, size_t body_size,
-                   uint8_t* out, size_t capacity) {
+                   uint8_t* out, size_t capacity, uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(type), seq);
+  encoder.Begin(static_cast<uint8_t>(type), seq, session);
   for (size_t i = 0; i < body_size; ++i) {
     encoder.Put(body[i]);
   }
@@ -353,20 +353,22 @@ size_t EncodeHello(uint16_t token, const Hello& hello, uint8_t* out, size_t capa
   encoder.Begin(static_cast<uint8_t>(MessageType::kHello), token);
   encoder.Put(hello.version);
   encoder.Put(hello.flags);
+  encoder.PutU32(hello.session);
   return encoder.Finish();
 }
 
-size_t EncodeStatusQuery(uint16_t token, uint8_t* out, size_t capacity) {
-  return EncodeFrame(MessageType::kStatusQuery, token, nullptr, 0, out, capacity);
+size_t EncodeStatusQuery(uint16_t token, uint8_t* out, size_t capacity, uint32_t session) {
+  return EncodeFrame(MessageType::kStatusQuery, token, nullptr, 0, out, capacity, session);
 }
 
-size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity) {
-  return EncodeFrame(MessageType::kStop, token, nullptr, 0, out, capacity);
+size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity, uint32_t session) {
+  return EncodeFrame(MessageType::kStop, token, nullptr, 0, out, capacity, session);
 }
 
-size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity) {
+size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity,
+                        uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(MessageType::kHelloReply), token);
+  encoder.Begin(static_cast<uint8_t>(MessageType::kHelloReply), token, session);
   encoder.Put(reply.version);
   encoder.PutU16(reply.next_seq);
   encoder.Put(reply.credits);
@@ -377,10 +379,10 @@ size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, s
   return encoder.Finish();
 }
 
-size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* out,
-                          size_t capacity) {
+size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* out, size_t capacity,
+                          uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(MessageType::kStatusReport), token);
+  encoder.Begin(static_cast<uint8_t>(MessageType::kStatusReport), token, session);
   encoder.Put(static_cast<uint8_t>(report.state));
   encoder.Put(static_cast<uint8_t>(report.error));
   encoder.Put(report.error_detail);
@@ -396,26 +398,26 @@ size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* o
   return encoder.Finish();
 }
 
-size_t EncodeAck(uint16_t seq, const Ack& ack, uint8_t* out, size_t capacity) {
+size_t EncodeAck(uint16_t seq, const Ack& ack, uint8_t* out, size_t capacity, uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(MessageType::kAck), seq);
+  encoder.Begin(static_cast<uint8_t>(MessageType::kAck), seq, session);
   encoder.PutU16(ack.next_seq);
   encoder.Put(ack.credits);
   return encoder.Finish();
 }
 
-size_t EncodeNak(uint16_t seq, const Nak& nak, uint8_t* out, size_t capacity) {
+size_t EncodeNak(uint16_t seq, const Nak& nak, uint8_t* out, size_t capacity, uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(MessageType::kNak), seq);
+  encoder.Begin(static_cast<uint8_t>(MessageType::kNak), seq, session);
   encoder.PutU16(nak.next_seq);
   encoder.Put(nak.credits);
   encoder.Put(static_cast<uint8_t>(nak.reason));
   return encoder.Finish();
 }
 
-size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity) {
+size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity, uint32_t session) {
   FrameEncoder encoder(out, capacity);
-  encoder.Begin(static_cast<uint8_t>(MessageType::kError), error.seq);
+  encoder.Begin(static_cast<uint8_t>(MessageType::kError), error.seq, session);
   encoder.Put(static_cast<uint8_t>(error.code));
   encoder.Put(error.detail);
   return encoder.Finish();
@@ -459,7 +461,7 @@ DecodeResult ValidateFields(const Command& command) {
   if (size == 0) {
     return DecodeResult{ErrorCode::kBadLength, 0};
   }
-  const Frame frame{static_cast<uint8_t>(command.type), command.seq, body, size};
+  const Frame frame{static_cast<uint8_t>(command.type), command.seq, body, size, true};
   Command decoded;
   return DecodeCommand(frame, &decoded);
 }
@@ -468,12 +470,15 @@ DecodeResult DecodeHello(const Frame& frame, Hello* out) {
   if (frame.body_size >= 1 && frame.body[0] != kProtocolVersion) {
     out->version = frame.body[0];
     out->flags = 0;
+    out->session = 0;
     return DecodeResult{ErrorCode::kUnsupportedVersion, kHelloFieldVersion};
   }
   Reader reader(frame);
   out->version = reader.U8(kHelloFieldVersion);
   out->flags = reader.U8(kHelloFieldFlags);
   reader.Check((out->flags & ~kHelloKnownFlags) == 0, kHelloFieldFlags);
+  out->session = reader.U32(kHelloFieldSession);
+  reader.Check(out->session != 0, kHelloFieldSession);
   reader.End(kHelloFieldCount);
   return reader.result();
 }
@@ -587,6 +592,8 @@ const char* ErrorName(ErrorCode code) {
       return "stopped";
     case ErrorCode::kOutputFailed:
       return "output failed";
+    case ErrorCode::kUnknownSession:
+      return "unknown session";
   }
   return "unknown error";
 }

@@ -99,8 +99,9 @@ void FrameEncoder::Raw(uint8_t byte) {
   }
 }
 
-void FrameEncoder::Begin(uint8_t type, uint16_t seq) {
+void FrameEncoder::Begin(uint8_t type, uint16_t seq, uint32_t session) {
   crc_ = Crc32();
+  tag_ = SessionTag(session);
   decoded_ = 0;
   code_ = 1;
   code_pos_ = 0;
@@ -141,7 +142,7 @@ void FrameEncoder::PutSignedVarint(int64_t value) {
 }
 
 size_t FrameEncoder::Finish() {
-  const uint32_t crc = crc_.Value();
+  const uint32_t crc = crc_.Value() ^ tag_;
   for (int shift = 0; shift < 32; shift += 8) {
     Raw(static_cast<uint8_t>((crc >> shift) & 0xFFu));
   }
@@ -159,7 +160,7 @@ size_t FrameEncoder::Finish() {
 FrameDecoder::FrameDecoder(uint8_t* buffer, size_t capacity)
     : buffer_(buffer),
       capacity_(capacity < kMaxFrameBytes ? capacity : kMaxFrameBytes),
-      frame_{0, 0, buffer, 0} {}
+      frame_{0, 0, buffer, 0, false} {}
 
 void FrameDecoder::Reset() {
   size_ = 0;
@@ -220,10 +221,12 @@ bool FrameDecoder::EndOfFrame() {
                             static_cast<uint32_t>(buffer_[payload + 1]) << 8 |
                             static_cast<uint32_t>(buffer_[payload + 2]) << 16 |
                             static_cast<uint32_t>(buffer_[payload + 3]) << 24;
-  if (ComputeCrc32(buffer_, payload) != received) {
+  const uint32_t tag = ComputeCrc32(buffer_, payload) ^ received;
+  if (tag != tag_ && tag != 0) {
     ++stats_.crc_errors;
     return false;
   }
+  frame_.in_session = tag == tag_;
   ++stats_.frames;
   frame_.type = buffer_[0];
   frame_.seq = static_cast<uint16_t>(static_cast<uint16_t>(buffer_[2]) << 8 | buffer_[1]);

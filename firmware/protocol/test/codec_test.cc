@@ -42,7 +42,7 @@ Bytes Wire(const Command& command) {
 
 // A frame with the command's type and seq around an arbitrary body.
 Frame BodyFrame(MessageType type, const Bytes& body) {
-  return Frame{static_cast<uint8_t>(type), 0, body.data(), body.size()};
+  return Frame{static_cast<uint8_t>(type), 0, body.data(), body.size(), true};
 }
 
 Bytes CommandBody(const Command& command) {
@@ -381,13 +381,20 @@ TEST(CodecValidation, UnknownTypes) {
 TEST(Codec, HelloAndEmptyBodies) {
   Bytes wire(kMaxEncodedFrameBytes);
   Bytes storage;
-  wire.resize(
-      EncodeHello(0x1234, Hello{kProtocolVersion, kHelloFlagNewSession}, wire.data(), wire.size()));
+  wire.resize(EncodeHello(0x1234, Hello{kProtocolVersion, kHelloFlagNewSession, 0xCAFE0042},
+                          wire.data(), wire.size()));
   const Frame f = Unwire(wire, &storage);
   EXPECT_EQ(f.seq, 0x1234);
   Hello h{};
   ASSERT_TRUE(DecodeHello(f, &h).ok());
   EXPECT_EQ(h.flags, kHelloFlagNewSession);
+  EXPECT_EQ(h.session, 0xCAFE0042u);
+  // Version 2: the session follows the flags, and 0 is not a session.
+  const Bytes no_session = {kProtocolVersion, 0, 0, 0, 0, 0};
+  EXPECT_EQ(DecodeHello(BodyFrame(MessageType::kHello, no_session), &h).field, kHelloFieldSession);
+  const Bytes short_session = {kProtocolVersion, 0, 1, 0};
+  EXPECT_EQ(DecodeHello(BodyFrame(MessageType::kHello, short_session), &h).code,
+            ErrorCode::kBadLength);
   const Bytes other_version = {kProtocolVersion + 1, 0, 0, 0};
   DecodeResult r = DecodeHello(BodyFrame(MessageType::kHello, other_version), &h);
   EXPECT_EQ(r.code, ErrorCode::kUnsupportedVersion);
@@ -568,7 +575,7 @@ TEST(Codec, DecoderFuzz) {
     }
     const auto type = static_cast<MessageType>(rng() % 4 == 0 ? rng() : 0x10 + rng() % 5);
     const Frame frame{static_cast<uint8_t>(type), static_cast<uint16_t>(rng()), body.data(),
-                      body.size()};
+                      body.size(), true};
     Command command;
     Reply reply;
     Hello hello;

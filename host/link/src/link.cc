@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdio>
 #include <limits>
+#include <random>
 #include <utility>
 
 #include "fdsurf/status.h"
@@ -102,9 +105,26 @@ std::string FieldName(MessageType type, uint8_t index) {
 
 }  // namespace
 
+// A session id no other host is likely to have chosen: 32 random bits.
+uint32_t RandomSession() {
+  std::random_device device;
+  const auto clock =
+      static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+  uint32_t session = 0;
+  while (session == 0) {
+    session = static_cast<uint32_t>(device()) ^ static_cast<uint32_t>(clock * 0x9E3779B97F4A7C15u);
+  }
+  return session;
+}
+
 HostLink::HostLink(HostLinkOptions options) : options_(options) {
   options_.window = std::clamp<uint16_t>(options_.window, 1, 0x7FFF);
-  options_.max_retries = std::max(options_.max_retries, 0);
+  options_.retransmit_timeout_us = std::max<uint64_t>(options_.retransmit_timeout_us, 1);
+  options_.max_retransmit_timeout_us =
+      std::max(options_.max_retransmit_timeout_us, options_.retransmit_timeout_us);
+  rto_us_ = options_.retransmit_timeout_us;
+  session_ = options_.session != 0 ? options_.session : RandomSession();
+  decoder_.set_session(session_);
 }
 
 protocol::DecodeResult HostLink::Enqueue(const protocol::Command& command, std::string label) {
@@ -134,6 +154,13 @@ void HostLink::OnBytes(const uint8_t* data, size_t size, uint64_t now_us) {
       ++stats_.bad_replies;
       continue;
     }
+    // A plain CRC is not of this session: only a device that predates
+    // sessions, refusing the HELLO's version, is believed without the tag.
+    if (!decoder_.frame().in_session && (reply.type != MessageType::kError ||
+                                         reply.body.error.code != ErrorCode::kUnsupportedVersion)) {
+      ++stats_.sessionless_replies;
+      continue;
+    }
     ++stats_.frames_received;
     if (state_ != State::kFailed) {
       HandleReply(reply, now_us);
@@ -147,7 +174,7 @@ void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
       HandleHelloReply(reply, now_us);
       return;
     case MessageType::kError:
-      HandleError(reply);
+      HandleError(reply, now_us);
       return;
     default:
       break;
@@ -180,6 +207,7 @@ void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
         ++stats_.queue_full_naks;
         next_send_ = 0;
       } else if (!fast_retransmit_done_) {
+        probe_ = false;
         // Go back to the device's next_seq at once. The other frames of
         // the old window still draw NAKs for the same seq; only the first
         // rewinds (per acknowledged position), else every stale NAK would
@@ -194,8 +222,11 @@ void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
         return;  // an old query's answer
       }
       status_outstanding_ = false;
-      retries_ = 0;
+      Progress(now_us);
       status_ = reply.body.status;
+      if (status_->state != protocol::DeviceState::kStopping) {
+        waiting_for_rest_ = false;  // at rest (or running): try again
+      }
       Acknowledge(status_->next_seq, status_->credits, now_us);
       if (status_->state == protocol::DeviceState::kFault) {
         Fail("device fault: " + std::string(protocol::ErrorName(status_->error)) + " (detail " +
@@ -233,7 +264,8 @@ void HostLink::HandleHelloReply(const protocol::Reply& reply, uint64_t now_us) {
   }
   credits_ = h.credits;
   next_send_ = 0;
-  retries_ = 0;
+  Progress(now_us);
+  probe_ = false;
   fast_retransmit_done_ = false;
   state_ = State::kRunning;
 }
@@ -248,7 +280,9 @@ bool HostLink::Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us) 
     base_seq_ = next_seq;
     next_send_ = next_send_ > advance ? next_send_ - advance : 0;
     sent_ -= advance;
-    retries_ = 0;
+    Progress(now_us);
+    probe_ = false;
+    stopped_wait_started_ = false;
     fast_retransmit_done_ = false;
     progress_us_ = now_us;
   }
@@ -256,7 +290,14 @@ bool HostLink::Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us) 
   return true;
 }
 
-void HostLink::HandleError(const protocol::Reply& reply) {
+void HostLink::Progress(uint64_t now_us) {
+  retries_ = 0;
+  rto_us_ = options_.retransmit_timeout_us;
+  progress_at_ = now_us;
+  progress_known_ = true;
+}
+
+void HostLink::HandleError(const protocol::Reply& reply, uint64_t now_us) {
   const protocol::ErrorReply& e = reply.body.error;
   std::string what;
   MessageType type = MessageType::kHello;
@@ -266,8 +307,30 @@ void HostLink::HandleError(const protocol::Reply& reply) {
            std::to_string(protocol::kProtocolVersion));
       return;
     }
+    if (e.code == ErrorCode::kUnknownSession) {
+      Fail(
+          "device lost the session on resume: it does not have this host's session (it was "
+          "reset, or another host started a session)");
+      return;
+    }
     what = "hello";
   } else if (const size_t index = static_cast<uint16_t>(e.seq - base_seq_); index < sent_) {
+    // "Stopped": the device decelerates (after a STOP, or after a new
+    // session cut the previous host's move short) and takes nothing until
+    // it is at rest. Wait for that and send again, for a bounded time.
+    if (e.code == ErrorCode::kStopped && index == 0 && !stop_requested_) {
+      if (!stopped_wait_started_) {
+        stopped_wait_started_ = true;
+        stopped_since_us_ = now_us;
+        ++stats_.stopped_waits;
+      }
+      if (now_us - stopped_since_us_ < options_.stopped_wait_us) {
+        waiting_for_rest_ = true;
+        next_send_ = 0;
+        probe_ = false;
+        return;
+      }
+    }
     what = Describe(index);
     type = queue_[index].type;
   } else if (status_outstanding_ && e.seq == status_token_) {
@@ -305,24 +368,40 @@ void HostLink::Fail(std::string message) {
   error_ = std::move(message);
 }
 
-bool HostLink::Timeout() {
+bool HostLink::Timeout(uint64_t now_us, std::vector<uint8_t>* out) {
   ++stats_.timeouts;
-  if (++retries_ > options_.max_retries) {
-    std::string waiting = "an answer";
-    if (state_ == State::kHandshake) {
-      waiting = "the hello reply";
-    } else if (next_send_ > 0 && !queue_.empty()) {
-      waiting = "the acknowledgement of " + Describe(0);
-    } else if (status_outstanding_) {
-      waiting = "a status report";
-    } else if (stop_requested_) {
-      waiting = "the acknowledgement of stop";
-    }
-    Fail("no answer from the device after " + std::to_string(options_.max_retries) +
-         " retries (waiting for " + waiting + ")");
-    return true;
+  ++retries_;
+  rto_us_ = std::min(rto_us_ * 2, options_.max_retransmit_timeout_us);
+  if (now_us - progress_at_ < options_.give_up_after_us) {
+    return false;
   }
-  return false;
+  std::string waiting = "an answer";
+  if (state_ == State::kHandshake) {
+    waiting = "the hello reply";
+  } else if (next_send_ > 0 && !queue_.empty()) {
+    waiting = "the acknowledgement of " + Describe(0);
+  } else if (status_outstanding_) {
+    waiting = "a status report";
+  } else if (stop_requested_) {
+    waiting = "the acknowledgement of stop";
+  }
+  // Tell the device to stop before giving up, so that it does not go on
+  // with the commands it queued (twice: the line is evidently bad).
+  if (session_started_) {
+    SendStop(out);
+    SendStop(out);
+  }
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%.1f", static_cast<double>(now_us - progress_at_) * 1e-6);
+  Fail("no answer from the device after " + std::to_string(retries_) + " retries in " + seconds +
+       " s (waiting for " + waiting + ")");
+  return true;
+}
+
+void HostLink::SendStop(std::vector<uint8_t>* out) {
+  stop_token_ = next_token_++;
+  std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+  Send(frame.data(), protocol::EncodeStop(stop_token_, frame.data(), frame.size(), session_), out);
 }
 
 void HostLink::Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out) {
@@ -335,7 +414,7 @@ void HostLink::SendHello(uint64_t now_us, std::vector<uint8_t>* out) {
   hello_token_ = next_token_++;
   const bool fresh = !session_started_ && options_.new_session;
   const protocol::Hello hello{protocol::kProtocolVersion,
-                              fresh ? protocol::kHelloFlagNewSession : uint8_t{0}};
+                              fresh ? protocol::kHelloFlagNewSession : uint8_t{0}, session_};
   std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
   Send(frame.data(), protocol::EncodeHello(hello_token_, hello, frame.data(), frame.size()), out);
   hello_sent_ = true;
@@ -346,7 +425,8 @@ void HostLink::SendHello(uint64_t now_us, std::vector<uint8_t>* out) {
 void HostLink::SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out) {
   status_token_ = next_token_++;
   std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
-  Send(frame.data(), protocol::EncodeStatusQuery(status_token_, frame.data(), frame.size()), out);
+  Send(frame.data(),
+       protocol::EncodeStatusQuery(status_token_, frame.data(), frame.size(), session_), out);
   status_outstanding_ = true;
   status_sent_us_ = now_us;
   ++stats_.status_queries;
@@ -361,29 +441,38 @@ uint64_t HostLink::RetransmitTimerStart() const {
 }
 
 size_t HostLink::SendLimit() const {
-  return std::min<size_t>({queue_.size(), options_.window, credits_});
+  if (waiting_for_rest_) {
+    return 0;
+  }
+  // After a timeout only the oldest frame goes (a probe): a window of patch
+  // frames resent into a dead or lossy line is wasted; once the probe is
+  // acknowledged, the rest follows (go-back-N from the device's next_seq).
+  return std::min<size_t>({queue_.size(), options_.window, credits_,
+                           probe_ ? size_t{options_.timeout_resend_frames} : SIZE_MAX});
 }
 
 void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
-  const uint64_t rto = options_.retransmit_timeout_us;
+  const uint64_t rto = Rto();
   if (state_ == State::kFailed) {
     return;
   }
+  if (!progress_known_) {
+    progress_known_ = true;  // the give-up clock starts with the first Poll
+    progress_at_ = now_us;
+  }
   if (state_ == State::kHandshake) {
     const bool resend = hello_sent_ && now_us - hello_sent_us_ >= rto;
-    if (!hello_sent_ || (resend && !Timeout())) {
+    if (!hello_sent_ || (resend && !Timeout(now_us, out))) {
       SendHello(now_us, out);
     }
     return;
   }
   if (stop_requested_) {
     if (!stop_acked_ && (!stop_sent_ || now_us - stop_sent_us_ >= rto)) {
-      if (stop_sent_ && Timeout()) {
+      if (stop_sent_ && Timeout(now_us, out)) {
         return;
       }
-      stop_token_ = next_token_++;
-      std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
-      Send(frame.data(), protocol::EncodeStop(stop_token_, frame.data(), frame.size()), out);
+      SendStop(out);
       stop_sent_ = true;
       stop_sent_us_ = now_us;
     }
@@ -391,17 +480,18 @@ void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
   }
   // Retransmit timeout: go back to the oldest unacknowledged frame.
   if (next_send_ > 0 && now_us - RetransmitTimerStart() >= rto) {
-    if (Timeout()) {
+    if (Timeout(now_us, out)) {
       return;
     }
     next_send_ = 0;
+    probe_ = options_.timeout_resend_frames != 0;
   }
   std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
   for (const size_t limit = SendLimit(); next_send_ < limit; ++next_send_) {
     Pending& p = queue_[next_send_];
     Send(frame.data(),
          protocol::EncodeFrame(p.type, SeqOf(next_send_), p.body.data(), p.body.size(),
-                               frame.data(), frame.size()),
+                               frame.data(), frame.size(), session_),
          out);
     p.last_sent_us = now_us;
     if (next_send_ < sent_) {
@@ -414,7 +504,7 @@ void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
   // Nothing in flight (all acknowledged, or waiting for credit): ask.
   if (next_send_ == 0) {
     if (status_outstanding_) {
-      if (now_us - status_sent_us_ >= rto && !Timeout()) {
+      if (now_us - status_sent_us_ >= rto && !Timeout(now_us, out)) {
         SendStatusQuery(now_us, out);
       }
     } else if (!Finished() && (stats_.status_queries == 0 ||
@@ -426,7 +516,7 @@ void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
 
 uint64_t HostLink::NextPollUs(uint64_t now_us) const {
   constexpr uint64_t kNever = std::numeric_limits<uint64_t>::max();
-  const uint64_t rto = options_.retransmit_timeout_us;
+  const uint64_t rto = Rto();
   switch (state_) {
     case State::kFailed:
       return kNever;
@@ -467,6 +557,9 @@ void HostLink::Resume() {
   status_outstanding_ = false;
   stop_sent_ = false;
   retries_ = 0;
+  rto_us_ = options_.retransmit_timeout_us;
+  progress_known_ = false;  // a fresh give-up clock from the next Poll
+  probe_ = false;
   decoder_.Reset();
 }
 

@@ -29,7 +29,7 @@ constexpr int32_t kMaxTravelSteps = (int32_t{1} << 30) - 1;
 /// kMaxPatchSteps + 1 lines.
 constexpr uint16_t kMaxLines = kMaxPatchSteps + 1;
 /// The largest ErrorCode value this version defines.
-constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kOutputFailed);
+constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kUnknownSession);
 
 /// Field indices (DecodeResult::field and ErrorReply::detail for kBadField).
 /// For kBadLength the index is that of the field cut short, or the number of
@@ -37,7 +37,8 @@ constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kOutputFailed
 // kHello
 constexpr uint8_t kHelloFieldVersion = 0;
 constexpr uint8_t kHelloFieldFlags = 1;
-constexpr uint8_t kHelloFieldCount = 2;
+constexpr uint8_t kHelloFieldSession = 2;
+constexpr uint8_t kHelloFieldCount = 3;
 // kConfig: per-axis fields take 3 consecutive indices (X, Y, Z).
 constexpr uint8_t kConfigFieldAxes = 0;
 constexpr uint8_t kConfigFieldStepsPerMeter = 1;  // 1..3
@@ -126,28 +127,31 @@ struct Reply {
 // ---- Encoding. Each writes one complete wire frame (COBS and delimiter
 // included) into `out` and returns its size, or 0 if it does not fit in
 // `capacity` (kMaxEncodedFrameBytes always fits). Encoding does not validate:
+// `session`: the session whose tag the CRC carries (frame.h); 0, the plain
+// CRC, is for HELLO only (EncodeHello always uses it).
 // the encoders write whatever the struct holds (dims beyond kMaxAxes are
 // clamped when choosing how much geometry to write, so they never read
 // outside the arrays), and the decoder refuses what is out of range.
 
-size_t EncodeCommand(const Command& command, uint8_t* out, size_t capacity);
+size_t EncodeCommand(const Command& command, uint8_t* out, size_t capacity, uint32_t session = 0);
 /// Only the body of a command (no type, seq, CRC or COBS) into `body`.
 /// Returns the body size, or 0 if it does not fit (no body is empty).
 size_t EncodeCommandBody(const Command& command, uint8_t* body, size_t capacity);
 /// A frame of `type` and `seq` around an already encoded body.
 size_t EncodeFrame(MessageType type, uint16_t seq, const uint8_t* body, size_t body_size,
-                   uint8_t* out, size_t capacity);
+                   uint8_t* out, size_t capacity, uint32_t session = 0);
 size_t EncodeHello(uint16_t token, const Hello& hello, uint8_t* out, size_t capacity);
-size_t EncodeStatusQuery(uint16_t token, uint8_t* out, size_t capacity);
-size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity);
-size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity);
-size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* out,
-                          size_t capacity);
+size_t EncodeStatusQuery(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
+size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
+size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity,
+                        uint32_t session = 0);
+size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* out, size_t capacity,
+                          uint32_t session = 0);
 /// `seq`: the seq or token of the frame acknowledged.
-size_t EncodeAck(uint16_t seq, const Ack& ack, uint8_t* out, size_t capacity);
-size_t EncodeNak(uint16_t seq, const Nak& nak, uint8_t* out, size_t capacity);
+size_t EncodeAck(uint16_t seq, const Ack& ack, uint8_t* out, size_t capacity, uint32_t session = 0);
+size_t EncodeNak(uint16_t seq, const Nak& nak, uint8_t* out, size_t capacity, uint32_t session = 0);
 /// The frame's seq field is `error.seq`.
-size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity);
+size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity, uint32_t session = 0);
 
 // ---- Decoding. All take a CRC-checked frame from FrameDecoder.
 
@@ -161,7 +165,8 @@ DecodeResult DecodeCommand(const Frame& frame, Command* out);
 DecodeResult ValidateFields(const Command& command);
 /// kHello. A first byte other than kProtocolVersion gives
 /// kUnsupportedVersion (field 0) whatever follows, so later versions may
-/// change the rest of the body; else kBadLength, kBadField (unknown flags).
+/// change the rest of the body; else kBadLength, kBadField (unknown flags,
+/// session 0).
 DecodeResult DecodeHello(const Frame& frame, Hello* out);
 /// kStatusQuery and kStop: the body must be empty (kBadLength, field 0).
 DecodeResult DecodeEmpty(const Frame& frame);

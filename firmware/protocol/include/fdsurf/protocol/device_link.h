@@ -13,6 +13,11 @@
 //    credits, kOutOfOrder), dropped; the host goes back to next_seq.
 //  - The expected seq with no credit left → NAK(next_seq, 0, kQueueFull).
 //  - HELLO, STATUS_QUERY and STOP are answered at once and echo their token.
+//  - Sessions (protocol version 2): a new-session HELLO names the session;
+//    every other frame, both ways, carries its tag in the CRC (frame.h). A
+//    frame of another session fails the CRC check and is dropped unanswered;
+//    so is any frame but HELLO before the first session. A resume HELLO for
+//    a session the device does not have is refused (kUnknownSession).
 //
 // Header-only, templated on the sink, so the freestanding core needs no
 // virtual functions. The link does no I/O and needs no clock: feed it bytes
@@ -58,6 +63,10 @@ struct DeviceLinkStats {
   uint32_t status_queries;
   uint32_t stops;
   uint32_t replies_dropped;  ///< no room in the output buffer
+  /// Frames with the plain CRC that need a session (all but HELLO), or any
+  /// frame but HELLO before the first session: dropped unanswered. Frames of
+  /// another session are counted as CRC errors (frame_stats()).
+  uint32_t sessionless;
 };
 
 /// Whether `seq` lies in the 0x8000 sequence numbers before `next`
@@ -109,6 +118,8 @@ class DeviceLink {
 
   /// The sequence number the link expects next.
   FDSURF_NODISCARD uint16_t next_seq() const { return next_seq_; }
+  /// The current session (0 before the first new-session HELLO).
+  FDSURF_NODISCARD uint32_t session() const { return session_; }
   FDSURF_NODISCARD const DeviceLinkStats& stats() const { return stats_; }
   /// Frames delivered and dropped by the framing layer (CRC, COBS, length).
   FDSURF_NODISCARD const FrameDecoderStats& frame_stats() const { return decoder_.stats(); }
@@ -117,14 +128,19 @@ class DeviceLink {
   void HandleFrame(const Frame& frame) {
     Compact();
     const MessageType type = static_cast<MessageType>(frame.type);
+    if (type == MessageType::kHello) {
+      HandleHello(frame);
+      return;
+    }
+    if (session_ == 0 || !frame.in_session) {
+      ++stats_.sessionless;  // nothing but HELLO outside a session
+      return;
+    }
     if (IsSequenced(type)) {
       HandleCommand(frame);
       return;
     }
     switch (type) {
-      case MessageType::kHello:
-        HandleHello(frame);
-        return;
       case MessageType::kStatusQuery: {
         const DecodeResult result = DecodeEmpty(frame);
         if (!result.ok()) {
@@ -135,7 +151,8 @@ class DeviceLink {
         StatusReport report = {};
         sink_->FillStatus(&report);
         report.next_seq = next_seq_;
-        Emit(EncodeStatusReport(frame.seq, report, out_ + out_end_, kOutputCapacity - out_end_));
+        Emit(EncodeStatusReport(frame.seq, report, out_ + out_end_, kOutputCapacity - out_end_,
+                                session_));
         return;
       }
       case MessageType::kStop: {
@@ -156,18 +173,31 @@ class DeviceLink {
   }
 
   void HandleHello(const Frame& frame) {
-    Hello hello;
+    Hello hello = {0, 0, 0};
     const DecodeResult result = DecodeHello(frame, &hello);
     if (!result.ok()) {
       // For a version mismatch the detail is the version this device speaks.
+      // The reply carries the HELLO's session if it got that far (else the
+      // plain CRC: a host of another version could not check a tag).
+      const uint32_t session = result.code == ErrorCode::kUnsupportedVersion ? 0 : hello.session;
       SendError(frame.seq, result.code,
-                result.code == ErrorCode::kUnsupportedVersion ? kProtocolVersion : result.field);
+                result.code == ErrorCode::kUnsupportedVersion ? kProtocolVersion : result.field,
+                session);
       return;
     }
     ++stats_.hellos;
     if ((hello.flags & kHelloFlagNewSession) != 0) {
-      sink_->Reset();
-      next_seq_ = 0;
+      // A repeat of the HELLO that opened the current session (its reply was
+      // lost, or the link duplicated it) changes nothing.
+      if (hello.session != session_) {
+        sink_->Reset();
+        next_seq_ = 0;
+        session_ = hello.session;
+        decoder_.set_session(session_);
+      }
+    } else if (hello.session != session_) {
+      SendError(frame.seq, ErrorCode::kUnknownSession, 0, hello.session);
+      return;
     }
     HelloReply reply;
     reply.version = kProtocolVersion;
@@ -177,7 +207,7 @@ class DeviceLink {
     reply.tick_hz = sink_->TickHz();
     reply.max_axes = sink_->MaxAxes();
     reply.max_lines = kMaxLines;
-    Emit(EncodeHelloReply(frame.seq, reply, out_ + out_end_, kOutputCapacity - out_end_));
+    Emit(EncodeHelloReply(frame.seq, reply, out_ + out_end_, kOutputCapacity - out_end_, session_));
   }
 
   void HandleCommand(const Frame& frame) {
@@ -214,15 +244,19 @@ class DeviceLink {
 
   void SendAck(uint16_t seq) {
     Emit(EncodeAck(seq, Ack{next_seq_, sink_->Credits()}, out_ + out_end_,
-                   kOutputCapacity - out_end_));
+                   kOutputCapacity - out_end_, session_));
   }
   void SendNak(uint16_t seq, ErrorCode reason) {
     Emit(EncodeNak(seq, Nak{next_seq_, sink_->Credits(), reason}, out_ + out_end_,
-                   kOutputCapacity - out_end_));
+                   kOutputCapacity - out_end_, session_));
   }
   void SendError(uint16_t seq, ErrorCode code, uint8_t detail) {
+    SendError(seq, code, detail, session_);
+  }
+  void SendError(uint16_t seq, ErrorCode code, uint8_t detail, uint32_t session) {
     ++stats_.errors;
-    Emit(EncodeError(ErrorReply{seq, code, detail}, out_ + out_end_, kOutputCapacity - out_end_));
+    Emit(EncodeError(ErrorReply{seq, code, detail}, out_ + out_end_, kOutputCapacity - out_end_,
+                     session));
   }
 
   // Replies are encoded straight into the free tail of out_. Before each
@@ -252,6 +286,7 @@ class DeviceLink {
   size_t out_begin_ = 0;
   size_t out_end_ = 0;
   uint16_t next_seq_ = 0;
+  uint32_t session_ = 0;  // 0: none yet
   DeviceLinkStats stats_ = {};
 };
 

@@ -11,8 +11,11 @@
 //
 //   type u8 | seq u16 LE | body (0..kMaxFrameBytes - 7 bytes) | crc32 u32 LE
 //
-// where the CRC-32 (crc32.h) covers type, seq and body. docs/protocol.md has
-// the details and a worked example.
+// where the CRC-32 (crc32.h) covers type, seq and body. Protocol version 2
+// folds the session id into it: the CRC field holds the CRC XOR
+// SessionTag(session), so a frame of another session fails the check and is
+// dropped like a corrupt one (HELLO, which opens a session, uses session 0:
+// the plain CRC). docs/protocol.md has the details and a worked example.
 #pragma once
 
 #include <stddef.h>
@@ -38,6 +41,13 @@ constexpr size_t MaxEncodedFrameBytes(size_t decoded_size) {
 /// Largest size on the wire of any frame.
 constexpr size_t kMaxEncodedFrameBytes = MaxEncodedFrameBytes(kMaxFrameBytes);
 
+/// What the CRC of a frame of session `session` is XORed with: 0 for session
+/// 0 (the plain CRC), and distinct for distinct sessions (multiplication by
+/// an odd constant is a bijection of the 32-bit integers).
+constexpr uint32_t SessionTag(uint32_t session) {
+  return static_cast<uint32_t>(session * 0x9E3779B1u);
+}
+
 /// COBS-encodes `size` bytes into `out` and appends the 0x00 delimiter.
 /// Returns the number of bytes written, or 0 if they do not fit in
 /// `capacity` (MaxEncodedFrameBytes(size) always fits). The encoding follows
@@ -59,8 +69,9 @@ class FrameEncoder {
  public:
   FrameEncoder(uint8_t* out, size_t capacity);
 
-  /// Starts a frame: type and sequence number (or token).
-  void Begin(uint8_t type, uint16_t seq);
+  /// Starts a frame: type and sequence number (or token), and the session
+  /// whose tag the CRC carries (0: the plain CRC).
+  void Begin(uint8_t type, uint16_t seq, uint32_t session = 0);
   /// Appends body bytes.
   void Put(uint8_t byte);
   void PutU16(uint16_t value);
@@ -85,6 +96,7 @@ class FrameEncoder {
   uint8_t code_ = 1;     // 1 + data bytes in the current block
   bool overflow_ = false;
   size_t decoded_ = 0;  // decoded bytes so far
+  uint32_t tag_ = 0;    // SessionTag of the frame's session
   Crc32 crc_;
 };
 
@@ -95,12 +107,16 @@ struct Frame {
   uint16_t seq;
   const uint8_t* body;
   size_t body_size;
+  /// The CRC carried the decoder's session tag (FrameDecoder::set_session);
+  /// false: it was the plain CRC (session 0), which only HELLO uses (and the
+  /// version-mismatch ERROR of a device that predates sessions).
+  bool in_session;
 };
 
 /// What the decoder dropped, and why. Drops are silent otherwise.
 struct FrameDecoderStats {
   uint32_t frames;       ///< valid frames delivered
-  uint32_t crc_errors;   ///< CRC mismatch
+  uint32_t crc_errors;   ///< CRC mismatch (corrupt, or a frame of another session)
   uint32_t overlong;     ///< more than the buffer (or kMaxFrameBytes) decoded bytes
   uint32_t cobs_errors;  ///< a COBS block ran into the delimiter
   uint32_t runts;        ///< shorter than type + seq + CRC (7 bytes), but not empty
@@ -122,6 +138,9 @@ class FrameDecoder {
 
   /// Forgets any partly received frame (e.g. after a reconnect). Counters stay.
   void Reset();
+  /// The session whose frames are delivered (with in_session set), besides
+  /// frames with the plain CRC. 0 (the default): plain CRC only.
+  void set_session(uint32_t session) { tag_ = SessionTag(session); }
   FDSURF_NODISCARD const FrameDecoderStats& stats() const { return stats_; }
 
  private:
@@ -135,6 +154,7 @@ class FrameDecoder {
   uint8_t code_ = 0;       // the current block's code byte; 0 before the first
   bool started_ = false;   // bytes seen since the last delimiter
   bool overflow_ = false;
+  uint32_t tag_ = 0;
   Frame frame_;
   FrameDecoderStats stats_ = {0, 0, 0, 0, 0};
 };

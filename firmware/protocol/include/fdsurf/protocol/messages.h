@@ -18,8 +18,9 @@
 namespace fdsurf {
 namespace protocol {
 
-/// Protocol version spoken by this code; HELLO carries it.
-constexpr uint8_t kProtocolVersion = 1;
+/// Protocol version spoken by this code; HELLO carries it. Version 2 adds
+/// the session id (Hello::session), folded into the CRC of every other frame.
+constexpr uint8_t kProtocolVersion = 2;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -57,9 +58,17 @@ constexpr uint8_t kHelloFlagNewSession = 0x01;  ///< forget sequence state and q
 constexpr uint8_t kHelloKnownFlags = kHelloFlagNewSession;
 
 /// kHello's body. The frame's seq field carries a token the reply echoes.
+/// HELLO is the one host frame with the plain CRC; every other frame of both
+/// directions carries SessionTag(session) in its CRC (frame.h), the HELLO's
+/// replies included.
 struct Hello {
   uint8_t version;
   uint8_t flags;
+  /// Chosen by the host, != 0. With kHelloFlagNewSession the device starts
+  /// this session (a repeat of the current one's HELLO is answered without
+  /// a reset); without it the device resumes it, or refuses with
+  /// kUnknownSession if it is not the session it has.
+  uint32_t session;
 };
 
 /// The machine the host drives, in steps. Sent once per job (sequenced, so
@@ -153,6 +162,7 @@ enum class ErrorCode : uint8_t {
   kOutOfOrder = 10,         ///< kNak: a sequence number ahead of the expected one
   kStopped = 11,            ///< a command arrived while a stop was in progress
   kOutputFailed = 12,       ///< a step or pen output failed (status: detail = hal::IoStatus)
+  kUnknownSession = 13,     ///< a resume HELLO for a session the device does not have
 };
 
 /// A short, stable name ("bad length", ...).

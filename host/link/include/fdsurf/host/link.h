@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The host's end of the device link: a reliable, in-order, exactly-once
 // sender of sequenced commands over an unreliable byte stream (go-back-N
-// with cumulative ACKs, NAK-triggered fast retransmission, credit-based flow
-// control; docs/protocol.md).
+// with cumulative ACKs, NAK-triggered fast retransmission, a single-frame
+// probe on timeout, timeouts with backoff and a time bound, credit-based flow
+// control, a session id of its own; docs/protocol.md).
 //
 // HostLink does no I/O and reads no clock: every call takes the current time
 // in microseconds, Poll() appends the bytes to send now and OnBytes() takes
@@ -36,19 +37,44 @@ struct HostLinkOptions {
   /// Most commands in flight (sent, not yet acknowledged); the device's
   /// credits may lower it further. 1..0x7FFF.
   uint16_t window = 16;
-  /// Time without progress after which the oldest unacknowledged frame
-  /// (and everything after it) is sent again; also HELLO and status queries.
-  /// The timer runs from the later of the frame's last transmission and the
-  /// last acknowledgement that released a command.
+  /// Time without progress after which the oldest unacknowledged frame is
+  /// sent again (alone, as a probe; the rest follows its acknowledgement);
+  /// also HELLO, STOP and status queries. The timer runs from the later of
+  /// the frame's last transmission and the last acknowledgement that
+  /// released a command. Each consecutive timeout doubles it, up to
+  /// max_retransmit_timeout_us; progress sets it back.
   uint64_t retransmit_timeout_us = 200'000;
-  /// Consecutive timeouts without any progress before Failed().
-  int max_retries = 20;
+  uint64_t max_retransmit_timeout_us = 400'000;
+  /// Time without any progress (an acknowledgement that releases a command,
+  /// a matching HELLO_REPLY or STATUS_REPORT) after which the host gives up:
+  /// it sends STOP and Failed() says "no answer from the device after N
+  /// retries in T s". Bounded by time, not a count of tries, so that losing
+  /// many frames in a row on a bad line is survived as long as the device
+  /// answers now and then.
+  uint64_t give_up_after_us = 30'000'000;
+  /// While the device refuses commands with "stopped" (it decelerates from
+  /// a stop, or from the previous host's session), wait for it to come to
+  /// rest and try again, for at most this long.
+  uint64_t stopped_wait_us = 30'000'000;
+  /// After a timeout, resend at most this many frames from the oldest
+  /// unacknowledged one (the rest follows their acknowledgement) instead of
+  /// the whole window; 0: the whole window (go-back-N). A smaller resend
+  /// saves bytes on a dead line but recovers slower on a lossy one: a window
+  /// resent nearly always gets some acknowledgement back, one frame at 20 %
+  /// faults 1 time in 4 (400 commands at 20 %: 7-8 s with 0, 8-10 s with 4,
+  /// 18-23 s with 1; docs/protocol.md §6).
+  uint16_t timeout_resend_frames = 0;
   /// Status queries while nothing is in flight (waiting for credit or for
   /// the device to finish).
   uint64_t status_interval_us = 50'000;
   /// HELLO with kHelloFlagNewSession: the device drops its queue and starts
-  /// at seq 0. Without it the host continues at the device's next_seq.
+  /// at seq 0. Without it the host continues at the device's next_seq (of
+  /// the session `session`, which must then be given).
   bool new_session = true;
+  /// The session id (protocol version 2): 0 picks a random one (never 0).
+  /// Every frame but HELLO carries it folded into its CRC, so frames of
+  /// another host's session are neither executed nor believed.
+  uint32_t session = 0;
 };
 
 struct HostLinkStats {
@@ -66,6 +92,8 @@ struct HostLinkStats {
   uint64_t naks = 0;
   uint64_t queue_full_naks = 0;
   uint64_t timeouts = 0;
+  uint64_t sessionless_replies = 0;  ///< plain-CRC replies ignored (not of this session)
+  uint64_t stopped_waits = 0;        ///< "stopped" refusals waited out
 };
 
 class HostLink {
@@ -85,7 +113,9 @@ class HostLink {
 
   /// Appends to `out` whatever should be sent now: HELLO until answered,
   /// retransmissions after a timeout or NAK, new commands within the window
-  /// and the device's credits, STOP, status queries.
+  /// and the device's credits, STOP, status queries. The Poll() that gives
+  /// up (Failed() afterwards) leaves STOP in `out`: write it before
+  /// checking Failed(), as every runner does.
   void Poll(uint64_t now_us, std::vector<uint8_t>* out);
 
   /// The earliest time at which Poll() will have something to do if no bytes
@@ -126,6 +156,8 @@ class HostLink {
   /// Commands enqueued since construction, and acknowledged.
   FDSURF_NODISCARD uint64_t enqueued() const { return enqueued_; }
   FDSURF_NODISCARD uint64_t acknowledged() const { return enqueued_ - queue_.size(); }
+  /// This host's session id.
+  FDSURF_NODISCARD uint32_t session() const { return session_; }
 
  private:
   enum class State { kHandshake, kRunning, kFailed };
@@ -142,21 +174,26 @@ class HostLink {
   // Returns false (and changes nothing) if next_seq is not one the host
   // has sent.
   bool Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us);
-  void HandleError(const protocol::Reply& reply);
+  void HandleError(const protocol::Reply& reply, uint64_t now_us);
   void Fail(std::string message);
   void Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out);
   void SendHello(uint64_t now_us, std::vector<uint8_t>* out);
   void SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out);
-  // Counts a timeout; returns true (and fails) after max_retries in a row.
-  bool Timeout();
+  // Counts a timeout and backs off; returns true (and sends STOP and fails)
+  // once nothing progressed for give_up_after_us.
+  bool Timeout(uint64_t now_us, std::vector<uint8_t>* out);
+  void SendStop(std::vector<uint8_t>* out);
+  void Progress(uint64_t now_us);
   FDSURF_NODISCARD std::string Describe(size_t index) const;
   FDSURF_NODISCARD uint16_t SeqOf(size_t index) const {
     return static_cast<uint16_t>(base_seq_ + index);
   }
   FDSURF_NODISCARD size_t SendLimit() const;
+  FDSURF_NODISCARD uint64_t Rto() const { return rto_us_; }
   FDSURF_NODISCARD uint64_t RetransmitTimerStart() const;
 
   HostLinkOptions options_;
+  uint32_t session_ = 0;
   State state_ = State::kHandshake;
   std::string error_;
   bool session_started_ = false;  // a handshake has set base_seq_
@@ -187,7 +224,14 @@ class HostLink {
   uint64_t stop_sent_us_ = 0;
   bool stop_sent_ = false;
 
-  int retries_ = 0;  // consecutive timeouts without progress
+  int retries_ = 0;           // consecutive timeouts without progress
+  uint64_t rto_us_ = 0;       // the retransmit timeout now (backed off)
+  uint64_t progress_at_ = 0;  // last progress, for give_up_after_us
+  bool progress_known_ = false;
+  bool probe_ = false;             // after a timeout: resend only the oldest frame
+  bool waiting_for_rest_ = false;  // the device said "stopped": poll until it is not
+  uint64_t stopped_since_us_ = 0;
+  bool stopped_wait_started_ = false;
   uint64_t enqueued_ = 0;
 
   std::optional<protocol::StatusReport> status_;
