@@ -40,7 +40,12 @@ class Session {
 
   // Most sessions begin with a configuration, so that motion commands are
   // validated against the machine and run rather than refused unconfigured.
+  // Sessions (protocol version 2): almost every input opens one with a
+  // new-session HELLO first, since the device drops everything else before.
   void Begin() {
+    session_ = 1 + in_.ConsumeIntegral<std::uint16_t>();
+    harness_->SetSession(session_);
+    if (in_.ConsumeIntegralInRange<int>(0, 7) != 7) NewSessionHello();
     if (in_.ConsumeIntegralInRange<int>(0, 3) != 3) Config();
   }
 
@@ -66,10 +71,10 @@ class Session {
         Pen();
         break;
       case 7:
-        Send(frame_, protocol::EncodeStatusQuery(token_++, frame_, sizeof frame_));
+        Send(frame_, protocol::EncodeStatusQuery(token_++, frame_, sizeof frame_, Tag()));
         break;
       case 8:
-        Send(frame_, protocol::EncodeStop(token_++, frame_, sizeof frame_));
+        Send(frame_, protocol::EncodeStop(token_++, frame_, sizeof frame_, Tag()));
         break;
       case 9:
         Run(in_.ConsumeIntegralInRange<std::uint32_t>(0, kMaxTicksPerRun));
@@ -159,13 +164,35 @@ class Session {
 
   // --- Actions.
 
+  // A HELLO: mostly of this session (a resume or a repeated new-session
+  // HELLO), sometimes a new session, sometimes any version, flags, session.
   void Hello() {
     protocol::Hello hello;
     hello.version = Rare() ? in_.ConsumeIntegral<std::uint8_t>() : protocol::kProtocolVersion;
     hello.flags = Rare() ? in_.ConsumeIntegral<std::uint8_t>()
                          : (in_.ConsumeBool() ? protocol::kHelloFlagNewSession : 0);
+    hello.session = Rare() ? in_.ConsumeIntegral<std::uint32_t>() : session_;
+    const bool opens = hello.version == protocol::kProtocolVersion &&
+                       hello.flags == protocol::kHelloFlagNewSession && hello.session != 0;
+    if (opens) {
+      // The device answers in the new session; follow it.
+      session_ = hello.session;
+      harness_->SetSession(session_);
+    }
     Send(frame_, protocol::EncodeHello(token_++, hello, frame_, sizeof frame_));
   }
+
+  void NewSessionHello() {
+    protocol::Hello hello;
+    hello.version = protocol::kProtocolVersion;
+    hello.flags = protocol::kHelloFlagNewSession;
+    hello.session = session_;
+    Send(frame_, protocol::EncodeHello(token_++, hello, frame_, sizeof frame_));
+  }
+
+  // The session a frame is tagged with: this one, rarely another (a stale
+  // frame of an old host, which the device must drop).
+  std::uint32_t Tag() { return Rare() ? session_ ^ (1u + in_.ConsumeIntegral<std::uint8_t>()) : session_; }
 
   void Config() {
     protocol::Command command;
@@ -246,7 +273,7 @@ class Session {
   // A valid frame with one byte changed (CRC, COBS or length errors), or a
   // lone delimiter.
   void Corrupted() {
-    const std::size_t n = protocol::EncodeStatusQuery(token_++, frame_, sizeof frame_);
+    const std::size_t n = protocol::EncodeStatusQuery(token_++, frame_, sizeof frame_, session_);
     if (in_.ConsumeBool()) {
       frame_[in_.ConsumeIntegralInRange<std::size_t>(0, n - 1)] =
           in_.ConsumeIntegral<std::uint8_t>();
@@ -282,7 +309,7 @@ class Session {
 
   void SendCommand(protocol::Command& command) {
     command.seq = Seq();
-    const std::size_t n = protocol::EncodeCommand(command, frame_, sizeof frame_);
+    const std::size_t n = protocol::EncodeCommand(command, frame_, sizeof frame_, Tag());
     if (n == 0) __builtin_trap();  // kMaxEncodedFrameBytes always fits
     sent_type_ = command.type;
     sent_seq_ = command.seq;
@@ -332,6 +359,7 @@ class Session {
   std::unique_ptr<DeviceHarness> harness_;
   std::uint8_t frame_[protocol::kMaxEncodedFrameBytes];
   std::uint16_t token_ = 0;
+  std::uint32_t session_ = 1;
   std::uint16_t next_seq_ = 0;
   protocol::MessageType sent_type_ = protocol::MessageType::kStatusQuery;
   std::uint16_t sent_seq_ = 0;

@@ -23,27 +23,32 @@ namespace {
 namespace protocol = fdsurf::protocol;
 using Bytes = std::vector<std::uint8_t>;
 
+// The session every seed runs in (protocol version 2: the frames after the
+// HELLO carry its tag in their CRC).
+constexpr std::uint32_t kSession = 0x5EED;
+
 class Session {
  public:
   void Hello() {
     std::uint8_t frame[protocol::kMaxEncodedFrameBytes];
-    Append(frame, protocol::EncodeHello(
-                      token_++, {protocol::kProtocolVersion, protocol::kHelloFlagNewSession}, frame,
-                      sizeof frame));
+    Append(frame, protocol::EncodeHello(token_++,
+                                        {protocol::kProtocolVersion,
+                                         protocol::kHelloFlagNewSession, kSession},
+                                        frame, sizeof frame));
     seq_ = 0;
   }
   void Status() {
     std::uint8_t frame[protocol::kMaxEncodedFrameBytes];
-    Append(frame, protocol::EncodeStatusQuery(token_++, frame, sizeof frame));
+    Append(frame, protocol::EncodeStatusQuery(token_++, frame, sizeof frame, kSession));
   }
   void Stop() {
     std::uint8_t frame[protocol::kMaxEncodedFrameBytes];
-    Append(frame, protocol::EncodeStop(token_++, frame, sizeof frame));
+    Append(frame, protocol::EncodeStop(token_++, frame, sizeof frame, kSession));
   }
   void Command(protocol::Command command) {
     command.seq = seq_++;
     std::uint8_t frame[protocol::kMaxEncodedFrameBytes];
-    Append(frame, protocol::EncodeCommand(command, frame, sizeof frame));
+    Append(frame, protocol::EncodeCommand(command, frame, sizeof frame, kSession));
   }
   void Write(const std::string& path) const {
     std::FILE* file = std::fopen(path.c_str(), "wb");
