@@ -192,7 +192,9 @@ class Session {
 
   // The session a frame is tagged with: this one, rarely another (a stale
   // frame of an old host, which the device must drop).
-  std::uint32_t Tag() { return Rare() ? session_ ^ (1u + in_.ConsumeIntegral<std::uint8_t>()) : session_; }
+  std::uint32_t Tag() {
+    return Rare() ? session_ ^ (1u + in_.ConsumeIntegral<std::uint8_t>()) : session_;
+  }
 
   void Config() {
     protocol::Command command;

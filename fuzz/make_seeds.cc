@@ -31,10 +31,10 @@ class Session {
  public:
   void Hello() {
     std::uint8_t frame[protocol::kMaxEncodedFrameBytes];
-    Append(frame, protocol::EncodeHello(token_++,
-                                        {protocol::kProtocolVersion,
-                                         protocol::kHelloFlagNewSession, kSession},
-                                        frame, sizeof frame));
+    Append(frame,
+           protocol::EncodeHello(
+               token_++, {protocol::kProtocolVersion, protocol::kHelloFlagNewSession, kSession},
+               frame, sizeof frame));
     seq_ = 0;
   }
   void Status() {
