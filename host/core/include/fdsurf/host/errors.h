@@ -8,6 +8,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include "fdsurf/config/nodiscard.h"
 
 namespace fdsurf::host {
