@@ -312,10 +312,27 @@ TEST_F(Cli, StreamRefusesATravelTooLongForTheDeviceBeforeSendingAnything) {
   EXPECT_EQ(r.err.find("frames sent"), std::string::npos) << r.err;
 }
 
+// With the device's compute time charged as on an ATmega2560, validating a
+// 16-line teapot patch takes longer than the link's first retransmit
+// timeout: the link shows it (timeouts, resent frames) and still finishes
+// with the same drawing; without the cost there are none.
+TEST_F(Cli, StreamChargesTheDevicesComputeTimeOnRequest) {
+  const std::string job =
+      "stream '" + kTeapot + "' --fit 24x18 --speed 250 --accel 5000 --pen-delay 5";
+  const RunResult free = Run(job);
+  ASSERT_EQ(free.exit_code, 0) << free.err;
+  EXPECT_NE(free.err.find(" 0 timeouts"), std::string::npos) << free.err;
+  const RunResult mega = Run(job + " --sim-cost atmega2560");
+  ASSERT_EQ(mega.exit_code, 0) << mega.err;
+  EXPECT_EQ(mega.err.find(" 0 timeouts"), std::string::npos) << mega.err;
+  EXPECT_NE(mega.err.find("(--tolerance): within"), std::string::npos) << mega.err;
+}
+
 TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   ExpectRefused("stream '" + kTeapot + "' --device serial", "--device: 'serial' is not sim");
   ExpectRefused("stream '" + kTeapot + "' --device usb --faults 0.1",
-                "--svg, --png and --faults are for --device sim");
+                "--svg, --png, --faults and --sim-cost are for --device sim");
+  ExpectRefused("stream '" + kTeapot + "' --sim-cost z80", "--sim-cost");
   ExpectRefused("stream '" + kTeapot + "' --travel 100x100", "--travel X 100 mm is smaller than");
   ExpectRefused("stream '" + kTeapot + "' --tolerance 0.005", "--tolerance 0.005 mm is too small");
   ExpectRefused("stream '" + kTeapot + "' --tick-hz 30000", "--tick-hz: 30000 does not divide");

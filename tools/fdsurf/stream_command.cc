@@ -107,6 +107,11 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   command->add_option("--seed", o->seed, "sim: seed of the fault injection")->capture_default_str();
+  command
+      ->add_option("--sim-cost", o->sim_cost,
+                   "sim: charge the device's validation time as on this MCU (none, atmega2560)")
+      ->check(CLI::IsMember({"none", "atmega2560"}))
+      ->capture_default_str();
   command->add_option("--svg", o->svg, "sim: write what the plotter drew as SVG");
   command->add_option("--png", o->png, "sim: draw what the plotter drew as a PNG picture");
   command->add_option("--size", o->png_width, "PNG width in pixels")
@@ -123,8 +128,8 @@ int RunStream(const StreamOptions& o) {
     throw InputError("--device: '" + o.device +
                      "' is not sim, usb[:VID:PID|:BUS-PORT] or gpio:CHIP:LINES");
   }
-  if (!sim && (!o.svg.empty() || !o.png.empty() || o.faults > 0)) {
-    throw InputError("--svg, --png and --faults are for --device sim");
+  if (!sim && (!o.svg.empty() || !o.png.empty() || o.faults > 0 || o.sim_cost != "none")) {
+    throw InputError("--svg, --png, --faults and --sim-cost are for --device sim");
   }
   if (sim && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000");

@@ -33,6 +33,9 @@ struct StreamOptions {
   // The link and the simulator.
   std::uint64_t link_bytes_per_second = 1'000'000;
   double faults = 0;
+  /// sim: what the device's validation costs in virtual time: "none" or
+  /// "atmega2560" (16 MHz, the cycles measured under simavr).
+  std::string sim_cost = "none";
   std::uint64_t seed = 1;
   std::string svg;
   std::string png;

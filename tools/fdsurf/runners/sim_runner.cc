@@ -68,6 +68,7 @@ sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o) {
   options.to_device = sim::FaultRates::All(o.faults);
   options.to_host = sim::FaultRates::All(o.faults);
   options.fault_seed = o.seed;
+  if (o.sim_cost == "atmega2560") options.device_cost = sim::DeviceCost::Atmega2560();
   return options;
 }
 
