@@ -15,7 +15,7 @@ packages=(
   # (libclang_rt.fuzzer and the sanitizers are in libclang-rt-14-dev).
   clang libclang-rt-14-dev
   libcairo2-dev
-  libusb-1.0-0-dev libgpiod-dev gpiod
+  libusb-1.0-0-dev libgpiod-dev gpiod libserialport-dev
   python3 hp2xx librsvg2-bin
   # Microcontroller images under emulation (targets/README.md): the cross
   # compilers, QEMU (Cortex-M, RV32) and simavr with its library (AVR).

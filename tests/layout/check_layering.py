@@ -36,7 +36,9 @@ BOXES = {
     "host-toolpath": ["host/toolpath"],
     "host-stream": ["host/stream"],
     "host-link": ["host/link"],
+    "hal-libserialport": ["hal/libserialport"],
     "sim": ["sim"],
+    "boards": ["boards"],
     "tools": ["tools"],
 }
 
@@ -66,7 +68,10 @@ ALLOWED = {
     "host-stream": {"engine", "protocol", "motion", "host-core", "host-reference",
                     "host-constructions", "host-toolpath"},
     "host-link": {"engine", "protocol"},
+    "hal-libserialport": {"hal"},
     "sim": CORE | {"hal-sim", "host-link"},
+    # A board port is firmware: the freestanding core and the HAL interfaces.
+    "boards": CORE,
     "tools": set(BOXES),
 }
 for allowed in ALLOWED.values():

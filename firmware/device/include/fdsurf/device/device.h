@@ -13,6 +13,17 @@
 //
 //   device.Tick(steppers, pen);  // at most one unit move or pen change
 //
+// On a host both run in one thread. On an MCU Tick() runs in the step
+// timer's interrupt: give the Device an `InterruptLock`, an RAII type that
+// masks that interrupt while it exists (e.g. saves SREG and clears I on AVR,
+// PRIMASK on Cortex-M). The main-loop calls take it only around the few
+// instructions they share with Tick() (the lookahead buffer's counters, the
+// executed count, the stop and fault state), never around the engine's
+// work, so a long validation or set-up delays no tick. Tick() itself never
+// touches what only the main loop owns (the queue, the path generator):
+// the end of a stop and the queue drop after an output failure are finished
+// by the next Fill().
+//
 // Commands are validated when they arrive (the engine's planner runs over
 // every line a patch will draw, every line is checked against the machine's
 // travel, and the travel is capped so that every move between two points in
@@ -36,11 +47,21 @@
 namespace fdsurf {
 namespace device {
 
+/// The InterruptLock of a Device whose Tick() runs in the same thread as its
+/// main loop (the simulator, the GPIO runner): nothing to mask. (Its
+/// constructor is user-provided so that `const InterruptLock lock;` is not
+/// an unused variable to the compiler.)
+struct SingleThreadLock {
+  SingleThreadLock() {}  // NOLINT(modernize-use-equals-default)
+};
+
 /// kAxes: 2 (a pen plotter) or 3 (a CNC with Z). kQueueCapacity: commands
 /// that can wait (the host's credit). kLookahead: unit moves and events
 /// buffered ahead of the motion, a power of two; the loop reaches full speed
 /// only if the buffer holds the braking distance (docs/motion.md).
-template <int kAxes, int kQueueCapacity = 8, int kLookahead = 1024>
+/// InterruptLock: see the top of this file.
+template <int kAxes, int kQueueCapacity = 8, int kLookahead = 1024,
+          class InterruptLock = SingleThreadLock>
 class Device {
  public:
   static_assert(kAxes == 2 || kAxes == 3, "2 or 3 axes");
@@ -83,16 +104,23 @@ class Device {
   /// Starts queued commands and expands them into the lookahead buffer until
   /// it is full or there is nothing left to do. A configuration waits until
   /// everything before it has been executed, then takes effect.
+  /// Also finishes what Tick() left to the main loop: a stop that has come
+  /// to rest (the buffer dropped, the pen lifted) and the queue drop after a
+  /// fault.
   void Fill() {
-    while (!fault_ && !motion_.Stopping() && !motion_.Full()) {
+    FinishStopAtRest();
+    for (;;) {
+      if (fault_) {
+        DropQueue();
+        return;
+      }
+      if (!RoomToFill()) return;
       if (generator_.Idle()) {
         if (queued_ == 0) return;
         const protocol::Command& next = queue_[queue_head_];
         if (next.type == protocol::MessageType::kConfig) {
-          if (!motion_.Idle()) return;
-          ApplyConfig(next.body.config);
+          if (!ApplyConfigAtRest(next.body.config)) return;
           PopCommand();
-          ++executed_;
           continue;
         }
         generator_.Start(next);
@@ -105,13 +133,16 @@ class Device {
         }
         continue;
       }
-      motion_.Push(entry);
+      // RoomToFill() saw room, and Tick() only ever makes more.
+      const InterruptLock lock;
+      (void)motion_.Push(entry);
     }
   }
 
   /// One tick of the step timer: at most one unit move (one step per axis)
   /// or one pen change, written to the outputs. An output error faults the
-  /// device (it stops; STATUS reports it).
+  /// device (it stops; STATUS reports it). Safe to call from an interrupt
+  /// (see the top of this file).
   hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) {
     // After a fault the motion still comes to rest along its path and the
     // pen is lifted, unless the outputs themselves failed.
@@ -134,11 +165,14 @@ class Device {
       if (status == hal::IoStatus::kOk) status = steppers.Step(out.step_mask);
     }
     if (status != hal::IoStatus::kOk) {
+      // The queue is the main loop's: Fill() drops it on seeing fault_.
       outputs_failed_ = true;
-      Fault(protocol::ErrorCode::kOutputFailed, static_cast<uint8_t>(status));
+      error_ = protocol::ErrorCode::kOutputFailed;
+      error_detail_ = static_cast<uint8_t>(status);
+      fault_ = true;
+      motion_.Stop();
       return status;
     }
-    if (motion_.Stopping() && motion_.speed() == 0) FinishStop();
     return hal::IoStatus::kOk;
   }
 
@@ -201,6 +235,7 @@ class Device {
   FDSURF_NODISCARD uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
 
   void FillStatus(protocol::StatusReport* report) const {
+    const InterruptLock lock;
     if (fault_) {
       report->state = protocol::DeviceState::kFault;
     } else if (motion_.Stopping()) {
@@ -222,8 +257,8 @@ class Device {
   /// STOP: the queue is dropped now; the motion decelerates to rest along
   /// its path, then the rest of the buffer is dropped and the pen lifted.
   void Stop() {
-    queued_ = 0;
-    queue_head_ = 0;
+    DropQueue();
+    const InterruptLock lock;
     if (motion_.Idle()) {
       FinishStop();
     } else {
@@ -235,6 +270,7 @@ class Device {
   /// forgotten too.
   void Reset() {
     Stop();
+    const InterruptLock lock;
     configured_ = false;
     executed_ = 0;
     fault_ = false;
@@ -262,10 +298,31 @@ class Device {
     generator_.Reset(motion_.position(), false);
   }
 
-  void ApplyConfig(const protocol::MachineConfig& config) {
+  // A configuration takes effect once everything before it has been
+  // executed; false while the motion is not at rest yet.
+  bool ApplyConfigAtRest(const protocol::MachineConfig& config) {
+    const InterruptLock lock;
+    if (!motion_.Idle()) return false;
     motion::TickLimits tick;
     // Accept() checked the same conversion.
     if (motion::ToTickLimits(LimitsOf(config), &tick)) motion_.Configure(tick);
+    ++executed_;
+    return true;
+  }
+
+  FDSURF_NODISCARD bool RoomToFill() const {
+    const InterruptLock lock;
+    return !motion_.Stopping() && !motion_.Full();
+  }
+
+  void FinishStopAtRest() {
+    const InterruptLock lock;
+    if (motion_.Stopping() && motion_.speed() == 0) FinishStop();
+  }
+
+  void DropQueue() {
+    queued_ = 0;
+    queue_head_ = 0;
   }
 
   void PopCommand() {
@@ -282,12 +339,13 @@ class Device {
     }
   }
 
+  // A fault found by the main loop (Tick() records its own).
   void Fault(protocol::ErrorCode error, uint8_t detail) {
+    DropQueue();
+    const InterruptLock lock;
     fault_ = true;
     error_ = error;
     error_detail_ = detail;
-    queued_ = 0;
-    queue_head_ = 0;
     motion_.Stop();
   }
 
