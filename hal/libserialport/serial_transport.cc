@@ -86,8 +86,9 @@ bool BaudConstant(uint32_t baud, speed_t* speed) {
 }
 
 // Raw 8N1, no flow control, `baud`, through termios (ports libserialport
-// does not take). Returns "" or what failed.
-std::string ConfigureTermios(int fd, uint32_t baud, IoStatus* status) {
+// does not take). A pty has no line rate: a baud termios has no constant for
+// (250000) is accepted there and changes nothing. Returns "" or what failed.
+std::string ConfigureTermios(int fd, uint32_t baud, bool pty, IoStatus* status) {
   termios tio{};
   if (tcgetattr(fd, &tio) != 0) {
     *status = IoStatus::kIoError;
@@ -97,15 +98,14 @@ std::string ConfigureTermios(int fd, uint32_t baud, IoStatus* status) {
   tio.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | CSTOPB | CRTSCTS);
   tio.c_cflag |= CS8 | CLOCAL | CREAD;
   tio.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
-  tio.c_cc[VMIN] = 0;
-  tio.c_cc[VTIME] = 0;
   speed_t speed = B0;
-  if (!BaudConstant(baud, &speed)) {
+  if (BaudConstant(baud, &speed)) {
+    cfsetispeed(&tio, speed);
+    cfsetospeed(&tio, speed);
+  } else if (!pty) {
     *status = IoStatus::kInvalidArgument;
     return "baud " + std::to_string(baud) + " is not one termios can set";
   }
-  cfsetispeed(&tio, speed);
-  cfsetospeed(&tio, speed);
   if (tcsetattr(fd, TCSANOW, &tio) != 0) {
     *status = IoStatus::kIoError;
     return std::string("cannot configure: ") + std::strerror(errno);
@@ -133,6 +133,18 @@ std::string ConfigureWithLibserialport(struct sp_port* port, uint32_t baud, IoSt
   if (sp_set_stopbits(port, 1) != SP_OK) return failed("1 stop bit");
   if (sp_set_flowcontrol(port, SP_FLOWCONTROL_NONE) != SP_OK) return failed("no flow control");
   return "";
+}
+
+// Non-blocking, VMIN 1 and VTIME 0: an empty line reads as EAGAIN, so that
+// a read of 0 bytes (end of file) is always a hang-up. (With VMIN 0 a tty
+// reads 0 bytes whenever nothing is there, O_NONBLOCK or not.)
+void ReadOneByteAtLeast(int fd) {
+  (void)fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+  termios tio{};
+  if (tcgetattr(fd, &tio) != 0) return;
+  tio.c_cc[VMIN] = 1;
+  tio.c_cc[VTIME] = 0;
+  (void)tcsetattr(fd, TCSANOW, &tio);
 }
 
 }  // namespace
@@ -178,7 +190,7 @@ IoStatus SerialTransport::Attach(const std::string& node, std::string* error) {
     fd = ::open(resolved, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
       status = DescribeOpenErrno(errno, &problem);
-    } else if (problem = ConfigureTermios(fd, options_.baud, &status); !problem.empty()) {
+    } else if (problem = ConfigureTermios(fd, options_.baud, std::strncmp(resolved, "/dev/pts/", 9) == 0, &status); !problem.empty()) {
       ::close(fd);
       fd = -1;
     }
@@ -201,7 +213,7 @@ IoStatus SerialTransport::Attach(const std::string& node, std::string* error) {
     return status == IoStatus::kOk ? IoStatus::kIoError : status;
   }
   (void)ioctl(fd, TIOCEXCL);
-  (void)fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+  ReadOneByteAtLeast(fd);
   (void)tcflush(fd, TCIOFLUSH);
   fd_ = fd;
   sp_port_ = port;
