@@ -77,7 +77,8 @@ int RunPorts(const PortsOptions& o) {
   }
   for (hal::SerialPortInfo& listed : hal::ListSerialPorts()) {
     const bool named = std::any_of(ports.begin(), ports.end(), [&](const auto& port) {
-      return std::filesystem::equivalent(port.path, listed.path);
+      std::error_code error;
+      return std::filesystem::equivalent(port.path, listed.path, error);
     });
     if (!named) ports.push_back(std::move(listed));
   }

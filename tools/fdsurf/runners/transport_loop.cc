@@ -83,9 +83,10 @@ void TransportLoop::Reconnect() {
     const auto slice = static_cast<std::uint32_t>(now >= deadline ? 0 : (deadline - now) / 1000);
     const hal::IoStatus status = transport_.Reconnect(std::min<std::uint32_t>(slice, 250));
     if (status == hal::IoStatus::kOk) break;
-    if (status != hal::IoStatus::kTimeout || now >= deadline) {
-      throw DeviceError(std::string(transport_.LastError()) + "; gave up after " +
-                        Seconds(options_.reconnect_timeout_ms * 1000ull));
+    if (status != hal::IoStatus::kTimeout) throw DeviceError(transport_.LastError());
+    if (now >= deadline) {
+      throw DeviceError(options_.device + ": lost and not back within " +
+                        Seconds(options_.reconnect_timeout_ms * 1000ull) + "; gave up");
     }
     if (InterruptGuard::Interrupted()) {
       throw DeviceError(options_.device +
