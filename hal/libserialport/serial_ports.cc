@@ -86,8 +86,9 @@ std::string SerialPortInfo::VidPid() const {
 bool ParseSerialDevice(std::string_view spec, SerialSpec* parsed, std::string* error) {
   std::string quoted(1, '\'');
   quoted.append(spec).push_back('\'');
-  const std::string usage = "; expected serial:PATH[:BAUD] (e.g. serial:/dev/ttyACM0:115200) "
-                            "or serial:auto";
+  const std::string usage =
+      "; expected serial:PATH[:BAUD] (e.g. serial:/dev/ttyACM0:115200) "
+      "or serial:auto";
   if (spec.substr(0, 7) != "serial:" || spec.size() == 7) {
     *error = "serial device " + quoted + " names no port" + usage;
     return false;
@@ -103,8 +104,8 @@ bool ParseSerialDevice(std::string_view spec, SerialSpec* parsed, std::string* e
   if (colon != std::string_view::npos) {
     const std::string_view baud = rest.substr(colon + 1);
     if (!AllDigits(baud)) {
-      *error = "serial device " + quoted + ": baud '" + std::string(baud) +
-               "' is not a number" + usage;
+      *error =
+          "serial device " + quoted + ": baud '" + std::string(baud) + "' is not a number" + usage;
       return false;
     }
     const unsigned long value = std::strtoul(std::string(baud).c_str(), nullptr, 10);

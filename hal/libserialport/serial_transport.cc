@@ -67,15 +67,14 @@ bool BaudConstant(uint32_t baud, speed_t* speed) {
   static const struct {
     uint32_t baud;
     speed_t speed;
-  } kSpeeds[] = {{50, B50},         {75, B75},         {110, B110},       {134, B134},
-                 {150, B150},       {200, B200},       {300, B300},       {600, B600},
-                 {1200, B1200},     {1800, B1800},     {2400, B2400},     {4800, B4800},
-                 {9600, B9600},     {19200, B19200},   {38400, B38400},   {57600, B57600},
-                 {115200, B115200}, {230400, B230400}, {460800, B460800}, {500000, B500000},
-                 {576000, B576000}, {921600, B921600}, {1000000, B1000000},
-                 {1152000, B1152000}, {1500000, B1500000}, {2000000, B2000000},
-                 {2500000, B2500000}, {3000000, B3000000}, {3500000, B3500000},
-                 {4000000, B4000000}};
+  } kSpeeds[] = {{50, B50},           {75, B75},           {110, B110},         {134, B134},
+                 {150, B150},         {200, B200},         {300, B300},         {600, B600},
+                 {1200, B1200},       {1800, B1800},       {2400, B2400},       {4800, B4800},
+                 {9600, B9600},       {19200, B19200},     {38400, B38400},     {57600, B57600},
+                 {115200, B115200},   {230400, B230400},   {460800, B460800},   {500000, B500000},
+                 {576000, B576000},   {921600, B921600},   {1000000, B1000000}, {1152000, B1152000},
+                 {1500000, B1500000}, {2000000, B2000000}, {2500000, B2500000}, {3000000, B3000000},
+                 {3500000, B3500000}, {4000000, B4000000}};
   for (const auto& entry : kSpeeds) {
     if (entry.baud == baud) {
       *speed = entry.speed;
@@ -190,7 +189,9 @@ IoStatus SerialTransport::Attach(const std::string& node, std::string* error) {
     fd = ::open(resolved, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
       status = DescribeOpenErrno(errno, &problem);
-    } else if (problem = ConfigureTermios(fd, options_.baud, std::strncmp(resolved, "/dev/pts/", 9) == 0, &status); !problem.empty()) {
+    } else if (problem = ConfigureTermios(fd, options_.baud,
+                                          std::strncmp(resolved, "/dev/pts/", 9) == 0, &status);
+               !problem.empty()) {
       ::close(fd);
       fd = -1;
     }
@@ -274,8 +275,8 @@ IoStatus SerialTransport::DoWrite(const uint8_t* data, size_t size, uint32_t tim
     pollfd p{fd_, POLLOUT, 0};
     const int ready = ::poll(&p, 1, RemainingMs(deadline));
     if (ready == 0 || (ready < 0 && errno == EINTR && SteadyClock::now() >= deadline)) {
-      return Fail(IoStatus::kTimeout, "write timed out" + progress() + " (" +
-                                          std::to_string(timeout_ms) + " ms)");
+      return Fail(IoStatus::kTimeout,
+                  "write timed out" + progress() + " (" + std::to_string(timeout_ms) + " ms)");
     }
     if (ready > 0 && (p.revents & (POLLHUP | POLLERR)) != 0) return HangUp("write" + progress());
   }
@@ -332,10 +333,10 @@ std::string SerialTransport::FindAgain() const {
 IoStatus SerialTransport::DoReconnect(uint32_t timeout_ms) {
   if (fd_ >= 0) return IoStatus::kOk;
   const auto deadline = SteadyClock::now() + std::chrono::milliseconds(timeout_ms);
-  const std::string who = identity_.usb_serial.empty()
-                              ? path_
-                              : path_ + " (usb " + identity_.VidPid() + " serial " +
-                                    identity_.usb_serial + ")";
+  const std::string who =
+      identity_.usb_serial.empty()
+          ? path_
+          : path_ + " (usb " + identity_.VidPid() + " serial " + identity_.usb_serial + ")";
   while (true) {
     const std::string node = FindAgain();
     std::string error = "serial " + who + ": no such port";

@@ -60,8 +60,9 @@ struct Pty {
 class SerialPty : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("fdsurf_serial_" + std::to_string(getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() /
+           ("fdsurf_serial_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     link_ = (dir_ / "ttyFD0").string();
     ASSERT_FALSE(pty_.name.empty());
@@ -221,15 +222,13 @@ TEST_F(SerialPty, ASecondOpenIsBusy) {
   EXPECT_EQ(SerialTransport::Open(link_, SerialOptions{}, &second, &error), IoStatus::kBusy);
   EXPECT_EQ(error, "serial " + link_ + ": busy (another program has it open)");
   first.reset();  // closing releases it
-  EXPECT_EQ(SerialTransport::Open(link_, SerialOptions{}, &second, &error), IoStatus::kOk)
-      << error;
+  EXPECT_EQ(SerialTransport::Open(link_, SerialOptions{}, &second, &error), IoStatus::kOk) << error;
 }
 
 TEST_F(SerialPty, AFileThatIsNoTtyIsRefused) {
   std::unique_ptr<SerialTransport> port;
   std::string error;
-  EXPECT_EQ(SerialTransport::Open("/dev/null", SerialOptions{}, &port, &error),
-            IoStatus::kIoError);
+  EXPECT_EQ(SerialTransport::Open("/dev/null", SerialOptions{}, &port, &error), IoStatus::kIoError);
   EXPECT_NE(error.find("serial /dev/null: not a serial port"), std::string::npos) << error;
 }
 

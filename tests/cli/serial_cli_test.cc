@@ -108,8 +108,8 @@ class SerialCli : public ::testing::Test {
   // Starts fdsurf with `args` (its outputs to files); returns its pid.
   pid_t Spawn(const std::string& args) {
     const std::string command = std::string("exec '") + FDSURF_BINARY + "' " + args + " >'" +
-                                (dir_ / "stdout").string() + "' 2>'" +
-                                (dir_ / "stderr").string() + "' </dev/null";
+                                (dir_ / "stdout").string() + "' 2>'" + (dir_ / "stderr").string() +
+                                "' </dev/null";
     const pid_t pid = fork();
     if (pid == 0) {
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
@@ -189,8 +189,9 @@ TEST_F(SerialCli, APortLostAndNotBackInTimeIsExit3NamingIt) {
   const Result r = Stream("--reconnect-timeout 1");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_LT(r.seconds, 10);
-  EXPECT_NE(r.err.find("fdsurf: error: serial " + link_ + ": lost and not back within 1.0 s; gave up"),
-            std::string::npos)
+  EXPECT_NE(
+      r.err.find("fdsurf: error: serial " + link_ + ": lost and not back within 1.0 s; gave up"),
+      std::string::npos)
       << r.err;
 }
 
@@ -253,7 +254,8 @@ TEST_F(SerialCli, ASlowDeviceGetsTheSpeedLoweredToItsTickRate) {
   StartDevice("--speedup 20 --tick-hz 5000");
   const Result r = Stream("--speed 100");
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("note: serial " + link_ + " ticks at 5000 Hz, one step per tick at most: "
+  EXPECT_NE(r.err.find("note: serial " + link_ +
+                       " ticks at 5000 Hz, one step per tick at most: "
                        "the speed limit is lowered from 8000 to 5000 steps/s (--speed 100 mm/s "
                        "becomes 62.5 mm/s)"),
             std::string::npos)

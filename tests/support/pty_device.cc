@@ -248,8 +248,8 @@ int main(int argc, char** argv) {
   std::printf("ready\n");
   std::fflush(stdout);
   const Clock::time_point start = Clock::now();
-  while (g_quit == 0 && std::chrono::duration<double>(Clock::now() - start).count() <
-                            o.time_limit_s) {
+  while (g_quit == 0 &&
+         std::chrono::duration<double>(Clock::now() - start).count() < o.time_limit_s) {
     pollfd p{run->pty.master, POLLIN, 0};
     (void)poll(&p, run->pty.master >= 0 ? 1 : 0, 1);
     run->Service();

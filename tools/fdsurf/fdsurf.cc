@@ -63,8 +63,9 @@ void AddCommands(CLI::App* app, Commands* c) {
       "joins", "Report for every shared edge of the patches whether the join is C0, G1 or C1.");
   AddJoinsOptions(c->joins, &c->joins_options);
   c->ports = app->add_subcommand(
-      "ports", "List the serial ports (USB VID:PID, serial number, product); --probe asks each "
-               "for the fdsurf firmware.");
+      "ports",
+      "List the serial ports (USB VID:PID, serial number, product); --probe asks each "
+      "for the fdsurf firmware.");
   AddPortsOptions(c->ports, &c->ports_options);
 }
 

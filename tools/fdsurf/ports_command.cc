@@ -22,8 +22,8 @@ std::string OrDash(const std::string& text) { return text.empty() ? "-" : text; 
 std::string Probe(const std::string& path, const PortsOptions& o, bool* answered) {
   std::string error;
   bool interrupted = false;
-  const auto session = ProbeSerialPort(path, o.baud, Milliseconds(o.timeout_s), true, &error,
-                                       &interrupted);
+  const auto session =
+      ProbeSerialPort(path, o.baud, Milliseconds(o.timeout_s), true, &error, &interrupted);
   *answered = session.has_value();
   if (!session) return error;
   const protocol::HelloReply& hello = *session->loop->link().hello();

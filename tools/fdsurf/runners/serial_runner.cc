@@ -29,8 +29,8 @@ SerialSession FindTheOneBoard(const StreamOptions& o, std::uint32_t baud) {
   for (const hal::SerialPortInfo& info : ports) {
     std::string error;
     bool interrupted = false;
-    auto session = ProbeSerialPort(info.path, baud, Milliseconds(o.connect_timeout_s), true,
-                                   &error, &interrupted);
+    auto session = ProbeSerialPort(info.path, baud, Milliseconds(o.connect_timeout_s), true, &error,
+                                   &interrupted);
     if (interrupted) throw DeviceError("serial:auto: interrupted while probing " + info.path);
     if (session) {
       answered_paths.push_back(info.path);
@@ -42,8 +42,9 @@ SerialSession FindTheOneBoard(const StreamOptions& o, std::uint32_t baud) {
   }
   if (answered.size() == 1) return std::move(answered.front());
   if (ports.empty()) {
-    throw DeviceError("serial:auto: no serial ports listed (a pty is never listed: name it, "
-                      "serial:PATH)");
+    throw DeviceError(
+        "serial:auto: no serial ports listed (a pty is never listed: name it, "
+        "serial:PATH)");
   }
   throw DeviceError(std::string("serial:auto: ") +
                     (answered.empty() ? "no port answered HELLO"

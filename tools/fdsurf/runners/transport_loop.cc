@@ -95,7 +95,8 @@ void TransportLoop::Reconnect() {
     }
   }
   ++reconnects_;
-  if (!options_.quiet) std::fprintf(stderr, "fdsurf: %s is back; resuming\n", options_.device.c_str());
+  if (!options_.quiet)
+    std::fprintf(stderr, "fdsurf: %s is back; resuming\n", options_.device.c_str());
   link_.Resume();
 }
 
@@ -131,7 +132,8 @@ bool TransportLoop::Connect() {
   const std::uint64_t start = hal::MonotonicClock::Now();
   while (!link_.Connected()) {
     if (InterruptGuard::Interrupted()) return false;
-    if (link_.Failed()) throw DeviceError(options_.device + ": " + DecodeDeviceError(link_.error()));
+    if (link_.Failed())
+      throw DeviceError(options_.device + ": " + DecodeDeviceError(link_.error()));
     const std::uint64_t waited = hal::MonotonicClock::Now() - start;
     if (waited >= options_.connect_timeout_ms * 1000ull) {
       throw DeviceError(options_.device + ": no answer to HELLO within " + Seconds(waited) + " (" +
@@ -190,8 +192,7 @@ int TransportLoop::StopAndReport(std::uint64_t total_commands) {
   if (!options_.quiet) std::fprintf(stderr, "fdsurf: interrupted: stopping the device\n");
   link_.RequestStop();
   tap_ = true;
-  const std::uint64_t deadline =
-      hal::MonotonicClock::Now() + options_.stop_timeout_ms * 1000ull;
+  const std::uint64_t deadline = hal::MonotonicClock::Now() + options_.stop_timeout_ms * 1000ull;
   std::string state = "unknown";
   bool rest = false;
   while (hal::MonotonicClock::Now() < deadline && !link_.Failed()) {
@@ -204,9 +205,11 @@ int TransportLoop::StopAndReport(std::uint64_t total_commands) {
                  "fdsurf: error: %s did not acknowledge STOP within %s: it may still be moving\n",
                  options_.device.c_str(), Seconds(options_.stop_timeout_ms * 1000ull).c_str());
   } else if (!rest) {
-    std::fprintf(stderr, "fdsurf: error: %s acknowledged STOP but was not at rest within %s "
-                 "(state %s)\n", options_.device.c_str(),
-                 Seconds(options_.stop_timeout_ms * 1000ull).c_str(), state.c_str());
+    std::fprintf(stderr,
+                 "fdsurf: error: %s acknowledged STOP but was not at rest within %s "
+                 "(state %s)\n",
+                 options_.device.c_str(), Seconds(options_.stop_timeout_ms * 1000ull).c_str(),
+                 state.c_str());
   } else {
     std::fprintf(stderr,
                  "fdsurf: stopped: %s is at rest (%s, pen %s) after %llu of %llu commands "
@@ -232,7 +235,8 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
   StreamJob fitted = job;
   fitted.config.max_rate = hello.tick_hz;
   for (protocol::Command& command : fitted.commands) {
-    if (command.type == protocol::MessageType::kConfig) command.body.config.max_rate = hello.tick_hz;
+    if (command.type == protocol::MessageType::kConfig)
+      command.body.config.max_rate = hello.tick_hz;
   }
   if (!o.quiet) {
     const double lowered = o.speed * hello.tick_hz / job.config.max_rate;
