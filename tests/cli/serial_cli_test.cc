@@ -288,6 +288,17 @@ TEST_F(SerialCli, PortsProbeOfASilentPortSaysSoAndExits3) {
             std::string::npos);
 }
 
+// ptys are never listed, so no listed port here runs the firmware: the
+// error says what was tried (or that nothing is listed).
+TEST_F(SerialCli, AutoWithoutAnAnsweringBoardIsExit3SayingWhatWasTried) {
+  const Result r = Run("stream " + kJob + " --device serial:auto --connect-timeout 0.5");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_LT(r.seconds, 20);
+  const bool tried = r.err.find("serial:auto: no port answered HELLO (tried ") != std::string::npos;
+  const bool none = r.err.find("serial:auto: no serial ports listed") != std::string::npos;
+  EXPECT_TRUE(tried || none) << r.err;
+}
+
 TEST_F(SerialCli, ABadDeviceStringIsExit2) {
   const Result r = Run("stream " + kJob + " --device serial:/dev/ttyACM0:fast");
   EXPECT_EQ(r.exit_code, 2);
