@@ -51,6 +51,10 @@ static_assert(kServoUpUs >= 500 && kServoUpUs <= 2500 && kServoDownUs >= 500 &&
 /// 8 KB of RAM (README.md has the measured budget).
 constexpr int kQueueCapacity = 4;
 constexpr int kLookahead = 256;
+/// Entries Device::Fill() may push before the main loop services the link
+/// again: expanding a point costs about 13 000 cycles here, so 16 is about
+/// 15 ms (README.md).
+constexpr uint16_t kFillBatch = 16;
 /// The UART receive ring (bytes): 11 ms of line at 115200 bit/s.
 constexpr uint8_t kRxRing = 128;
 

@@ -102,8 +102,14 @@ void KeepAlive() {
   wdt_reset();
 }
 
-// Nothing to do until the next interrupt (a received byte or a tick).
-bool NothingToDo() { return g_rx.Empty(); }
+// Nothing to do until the next interrupt (a received byte or a tick): no
+// byte waiting, and the lookahead full or nothing left to expand. (Read
+// without the lock: a stale answer costs at most one tick's sleep.)
+bool NothingToDo() {
+  if (!g_rx.Empty()) return false;
+  const fdsurf::motion::MotionLoop& motion = g_device.motion();
+  return motion.Full() || motion.Stopping() || g_device.Idle();
+}
 
 }  // namespace
 
@@ -166,7 +172,7 @@ int main() {
     g_in_service = true;
     (void)g_device.Service(g_link);  // a UART transport never fails
     g_in_service = false;
-    g_device.Fill();
+    g_device.Fill(kFillBatch);
     if (NothingToDo()) {
       sleep_enable();
       sleep_cpu();
