@@ -44,11 +44,14 @@ Recorder* g_recorder = nullptr;  // for simavr's sleep hook
 
 }  // namespace
 
-void CycleStats::Add(std::uint64_t cycles) {
+void CycleStats::Add(std::uint64_t cycles, std::uint64_t started_at) {
   ++count;
   sum += cycles;
   if (cycles < min) min = cycles;
-  if (cycles > max) max = cycles;
+  if (cycles > max) {
+    max = cycles;
+    max_at = started_at;
+  }
 }
 
 Recorder::~Recorder() {
@@ -162,17 +165,17 @@ void Recorder::OnTickRunning(avr_irq_t*, std::uint32_t value, void* param) {
     r->in_tick_ = true;
     r->stepped_ = false;
     const std::uint64_t latency = now - r->pending_at_;
-    r->latency_.Add(latency);
+    r->latency_.Add(latency, r->pending_at_);
     if (latency >= r->TickPeriod()) ++r->late_ticks_;
     return;
   }
   if (!r->in_tick_) return;
   r->in_tick_ = false;
   const std::uint64_t cycles = now - r->running_at_;
-  r->tick_.Add(cycles);
+  r->tick_.Add(cycles, r->running_at_);
   r->now_.isr += cycles;
   if (!r->stepped_) return;
-  r->stepping_tick_.Add(cycles);
+  r->stepping_tick_.Add(cycles, r->running_at_);
   ++r->now_.points;
   r->now_.cycle = now;
   if (!r->drawing_) r->first_step_ = r->now_;
@@ -187,7 +190,7 @@ void Recorder::OnRxRunning(avr_irq_t*, std::uint32_t value, void* param) {
     return;
   }
   const std::uint64_t cycles = r->avr_->cycle - r->rx_at_;
-  r->rx_.Add(cycles);
+  r->rx_.Add(cycles, r->rx_at_);
   r->now_.isr += cycles;
 }
 
@@ -235,6 +238,7 @@ void Stats(std::FILE* f, const char* name, const CycleStats& s) {
   Row(f, (n + "_cycles_min").c_str(), s.count == 0 ? 0.0 : static_cast<double>(s.min), "cycles");
   Row(f, (n + "_cycles_mean").c_str(), s.Mean(), "cycles");
   Row(f, (n + "_cycles_max").c_str(), static_cast<double>(s.max), "cycles");
+  Row(f, (n + "_max_at").c_str(), static_cast<double>(s.max_at) / 16e6, "s");
 }
 
 }  // namespace
@@ -259,6 +263,7 @@ bool Recorder::WriteMeasures(const std::string& path, avr_t* avr, const ImageFac
   Stats(f, "tick_isr", tick_);
   Stats(f, "stepping_tick_isr", stepping_tick_);
   Row(f, "tick_latency_cycles_max", static_cast<double>(latency_.max), "cycles");
+  Row(f, "tick_latency_max_at", static_cast<double>(latency_.max_at) / 16e6, "s");
   Row(f, "late_ticks", static_cast<double>(late_ticks_), "ticks");
   Row(f, "lost_ticks", static_cast<double>(lost_ticks_), "ticks");
   Stats(f, "rx_isr", rx_);

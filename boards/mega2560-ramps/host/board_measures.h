@@ -36,7 +36,8 @@ struct CycleStats {
   std::uint64_t sum = 0;
   std::uint64_t min = UINT64_MAX;
   std::uint64_t max = 0;
-  void Add(std::uint64_t cycles);
+  std::uint64_t max_at = 0;  // the cycle at which the longest one started
+  void Add(std::uint64_t cycles, std::uint64_t started_at = 0);
   [[nodiscard]] double Mean() const {
     return count == 0 ? 0.0 : static_cast<double>(sum) / static_cast<double>(count);
   }

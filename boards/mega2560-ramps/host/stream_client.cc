@@ -15,6 +15,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -95,7 +96,9 @@ ClientOptions Parse(int argc, char** argv) {
   return o;
 }
 
-StreamJob PlanJob(const ClientOptions& o) {
+// The job for a device of `tick_hz`: at most one step a tick, so the speed
+// is capped at tick_hz steps of 0.0125 mm a second.
+StreamJob PlanJob(const ClientOptions& o, std::uint32_t tick_hz) {
   PatchSet set = ReadPatchFile(o.file);
   if (o.patches > 0 && static_cast<std::size_t>(o.patches) < set.patches.size()) {
     set.patches.resize(static_cast<std::size_t>(o.patches));
@@ -111,7 +114,7 @@ StreamJob PlanJob(const ClientOptions& o) {
   drawing.dims = 2;
   drawing.mode = StepMode::kStepExact;
   MachineOptions machine;
-  machine.speed = o.speed;
+  machine.speed = std::min(o.speed, tick_hz * 0.0125);
   machine.accel = o.accel;
   machine.pen_delay_ms = 50;
   return BuildStreamJob(set, drawing, machine, "mm");
@@ -136,14 +139,54 @@ std::uint64_t NowUs() {
                                         .count());
 }
 
-// The link until the job is finished, it fails, or the time runs out.
-int Stream(int fd, const StreamJob& job, double timeout_s) {
+HostLinkOptions ClientLinkOptions() {
   HostLinkOptions options;
   options.status_interval_us = 250'000;
   // The Mega validates a patch for about 0.1-0.5 s before it answers.
   options.retransmit_timeout_us = 1'000'000;
   options.max_retransmit_timeout_us = 2'000'000;
-  HostLink link(options);
+  return options;
+}
+
+// One round of the link: what the board sent in, what the link has out.
+// False when the socket failed.
+bool Exchange(int fd, HostLink* link) {
+  timeval wait{0, 2000};
+  (void)setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &wait, sizeof wait);
+  std::uint8_t in[512];
+  const ssize_t n = recv(fd, in, sizeof in, 0);
+  if (n == 0) {
+    std::fprintf(stderr, "fdsurf_board_stream_client: the board closed the socket\n");
+    return false;
+  }
+  if (n > 0) link->OnBytes(in, static_cast<std::size_t>(n), NowUs());
+  std::vector<std::uint8_t> out;
+  link->Poll(NowUs(), &out);
+  if (!out.empty() && send(fd, out.data(), out.size(), MSG_NOSIGNAL) < 0) {
+    std::fprintf(stderr, "fdsurf_board_stream_client: send: %s\n", std::strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+// A session without commands, for the board's HELLO reply (its tick rate);
+// 0 when it does not answer in time.
+std::uint32_t AskTickRate(int fd, double timeout_s) {
+  HostLink link(ClientLinkOptions());
+  const std::uint64_t deadline = NowUs() + static_cast<std::uint64_t>(timeout_s * 1e6);
+  while (!link.hello() && !link.Failed() && NowUs() < deadline) {
+    if (!Exchange(fd, &link)) return 0;
+  }
+  if (!link.hello()) return 0;
+  std::printf("hello tick_hz=%u queue=%u axes=%u\n", link.hello()->tick_hz,
+              link.hello()->queue_capacity, link.hello()->max_axes);
+  std::fflush(stdout);
+  return link.hello()->tick_hz;
+}
+
+// The link until the job is finished, it fails, or the time runs out.
+int Stream(int fd, const StreamJob& job, double timeout_s) {
+  HostLink link(ClientLinkOptions());
   for (std::size_t k = 0; k < job.commands.size(); ++k) {
     if (!link.Enqueue(job.commands[k], job.labels[k]).ok()) {
       std::fprintf(stderr, "fdsurf_board_stream_client: %s cannot be sent\n",
@@ -152,30 +195,8 @@ int Stream(int fd, const StreamJob& job, double timeout_s) {
     }
   }
   const std::uint64_t deadline = NowUs() + static_cast<std::uint64_t>(timeout_s * 1e6);
-  bool hello_shown = false;
-  std::vector<std::uint8_t> out;
-  std::uint8_t in[512];
   while (!link.Finished() && !link.Failed() && NowUs() < deadline) {
-    timeval wait{0, 2000};
-    (void)setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &wait, sizeof wait);
-    const ssize_t n = recv(fd, in, sizeof in, 0);
-    if (n == 0) {
-      std::fprintf(stderr, "fdsurf_board_stream_client: the board closed the socket\n");
-      return 3;
-    }
-    if (n > 0) link.OnBytes(in, static_cast<std::size_t>(n), NowUs());
-    out.clear();
-    link.Poll(NowUs(), &out);
-    if (!out.empty() && send(fd, out.data(), out.size(), MSG_NOSIGNAL) < 0) {
-      std::fprintf(stderr, "fdsurf_board_stream_client: send: %s\n", std::strerror(errno));
-      return 3;
-    }
-    if (!hello_shown && link.hello()) {
-      hello_shown = true;
-      std::printf("hello tick_hz=%u queue=%u axes=%u\n", link.hello()->tick_hz,
-                  link.hello()->queue_capacity, link.hello()->max_axes);
-      std::fflush(stdout);
-    }
+    if (!Exchange(fd, &link)) return 3;
   }
   if (!link.Finished()) {
     std::fprintf(stderr, "fdsurf_board_stream_client: %s\n",
@@ -196,18 +217,26 @@ int Stream(int fd, const StreamJob& job, double timeout_s) {
 int main(int argc, char** argv) {
   using namespace fdsurf::host;
   const ClientOptions o = Parse(argc, argv);
-  StreamJob job;
-  try {
-    job = PlanJob(o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "fdsurf_board_stream_client: %s: %s\n", o.file.c_str(), e.what());
-    return 2;
-  }
   const int fd = Connect(o.socket_path);
   if (fd < 0) {
     std::fprintf(stderr, "fdsurf_board_stream_client: --socket %s: %s\n", o.socket_path.c_str(),
                  std::strerror(errno));
     return 3;
+  }
+  const std::uint32_t tick_hz = AskTickRate(fd, 10);
+  if (tick_hz == 0) {
+    std::fprintf(stderr, "fdsurf_board_stream_client: --socket %s: no HELLO reply in 10 s\n",
+                 o.socket_path.c_str());
+    close(fd);
+    return 3;
+  }
+  StreamJob job;
+  try {
+    job = PlanJob(o, tick_hz);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fdsurf_board_stream_client: %s: %s\n", o.file.c_str(), e.what());
+    close(fd);
+    return 2;
   }
   std::printf("job commands=%zu patches=%zu max_rate=%u\n", job.commands.size(), job.patches.size(),
               job.config.max_rate);

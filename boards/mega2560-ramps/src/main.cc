@@ -146,6 +146,8 @@ extern "C" void SaveResetCause() {
   wdt_disable();
 }
 
+ISR(TIMER1_OVF_vect) { fdsurf::mega::g_pen.OnPeriodStart(); }
+
 ISR(USART0_RX_vect) { (void)fdsurf::mega::g_rx.Push(UDR0); }
 
 ISR(TIMER3_COMPA_vect) {

@@ -83,6 +83,10 @@ class RampsSteppers final : public hal::StepDirOutputs {
 
 /// The pen as a hobby servo on OC1A: Timer1 in fast PWM (mode 14, TOP =
 /// ICR1) at 2 MHz, 50 Hz; the pulse width is OCR1A / 2 microseconds.
+/// A new width takes effect at the start of the next 20 ms period, from
+/// Timer1's overflow interrupt (OnPeriodStart): the hardware buffers OCR1A
+/// in this mode anyway, simavr does not, and a width changed mid-pulse must
+/// not make one 21 ms pulse.
 class ServoPen final : public hal::PenOutput {
  public:
   ServoPen() = default;
@@ -91,12 +95,23 @@ class ServoPen final : public hal::PenOutput {
   /// OCR1A for a pulse of `us` microseconds.
   static constexpr uint16_t CompareFor(uint16_t us) { return static_cast<uint16_t>(us * 2u); }
 
+  /// Call from TIMER1_OVF_vect.
+  void OnPeriodStart() {
+    OCR1A = next_compare_;
+    TIMSK1 &= static_cast<uint8_t>(~_BV(TOIE1));
+  }
+
  private:
+  // Runs in the step interrupt, so the overflow interrupt cannot cut in.
   hal::IoStatus DoSetPen(bool down) override {
-    OCR1A = CompareFor(down ? kServoDownUs : kServoUpUs);
+    next_compare_ = CompareFor(down ? kServoDownUs : kServoUpUs);
+    TIFR1 = _BV(TOV1);  // an overflow flagged before now is not this period's start
+    TIMSK1 |= _BV(TOIE1);
     return hal::IoStatus::kOk;
   }
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
+
+  volatile uint16_t next_compare_ = CompareFor(kServoUpUs);
 };
 
 }  // namespace mega
