@@ -9,11 +9,10 @@
 #include <stdint.h>
 
 #include "board_stats.h"
-#include "fdsurf/board/byte_ring.h"
-#include "fdsurf/board/uart_transport.h"
 #include "fdsurf/device/device.h"
 #include "nrf51.h"
 #include "pins.h"
+#include "rx_ring.h"
 
 #ifndef FDSURF_MICROBIT_TICK_HZ
 #define FDSURF_MICROBIT_TICK_HZ 20000
@@ -121,9 +120,15 @@ class PinOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
   const char* DoLastError() const override { return ""; }
 };
 
-using BoardDevice = device::Device<2, 8, 1024, PrimaskLock>;
+// 256 lookahead entries hold the braking distance up to ~110 mm/s at
+// 2000 mm/s² and 0.0125 mm steps (v²/2a = 225 steps); the motion loop's
+// walk over the buffer at each pen event costs ~32 cycles per entry in the
+// tick (README.md, measures), so a longer buffer costs late ticks there.
+constexpr int kLookahead = 256;
+constexpr uint16_t kRxRingBytes = 2048;
+using BoardDevice = device::Device<2, 8, kLookahead, PrimaskLock>;
 
-ByteRing<128> g_rx;
+RxRing<kRxRingBytes> g_rx;
 BoardDevice g_device(kTickHz);
 PinOutputs g_outputs;
 uint32_t g_next_compare;
@@ -255,7 +260,10 @@ void fdsurf_board_timer_irq() {
   // QEMU's nrf51 timer raises a stale COMPARE[0] on the CC[0] write, which
   // would re-enter this handler at once (seen as ticks a period early).
   Reg(nrf51::TimerEventsCompare(0)) = 0;
-  if (lateness > kTickPeriod / 2) ++stats.late_ticks;
+  if (lateness > kTickPeriod / 2) {
+    ++stats.late_ticks;
+    if (g_device.motion().speed() != 0) ++stats.late_moving_ticks;
+  }
   if (lateness > stats.max_lateness) stats.max_lateness = lateness;
   const uint32_t moves = g_device.motion().moves();
   (void)g_device.Tick(g_outputs, g_outputs);
@@ -276,7 +284,7 @@ void fdsurf_board_main() {
   SetUpPins();
   SetUpClock();
   SetUpUart();
-  UartTransport<128, Uart> link(g_rx);
+  RingTransport<kRxRingBytes, Uart> link(g_rx);
   SetUpTimer();
   for (;;) ServiceOnce(link);
 }

@@ -26,6 +26,9 @@ struct BoardStats {
   uint32_t ticks;
   uint32_t late_ticks;
   uint32_t missed_ticks;
+  /// Late ticks while the machine was moving (speed > 0), the ones that
+  /// shift a step edge; the others fall in a pen change's rest.
+  uint32_t late_moving_ticks;
   /// Worst delay from the compare event to the first instruction of the
   /// handler's body (exception entry and any masked section included).
   uint32_t max_lateness;
