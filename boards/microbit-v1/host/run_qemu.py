@@ -120,6 +120,10 @@ class Waveform:
         self.out.close()
         os.replace(self.path + ".tmp", self.path)
 
+    def discard(self):
+        self.out.close()
+        os.unlink(self.path + ".tmp")
+
 
 class UartPacer:
     """Client bytes waiting for the emulated line; released one byte time
@@ -200,8 +204,10 @@ def qemu_command(args, work, plugin):
             "-trace", "enable=nrf51_gpio_update_output_irq"]
 
 
-def connect_unix(path, deadline):
+def connect_unix(path, deadline, process=None):
     while True:
+        if process is not None and process.poll() is not None:
+            raise SystemExit(f"run_qemu.py: QEMU exited at start ({process.returncode})")
         try:
             sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
             sock.connect(path)
@@ -246,6 +252,8 @@ class Harness:
         self.log = None
         self.tx_bytes = 0
         self.clients = 0
+        self.qemu = None
+        self.listener = None
 
     def start(self):
         plugin = self.args.plugin or (DEFAULT_PLUGIN if os.path.exists(DEFAULT_PLUGIN)
@@ -257,7 +265,7 @@ class Harness:
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                      stderr=open(f"{self.work}/qemu.stderr", "w"))
         deadline = time.monotonic() + 10
-        self.uart = connect_unix(f"{self.work}/uart.sock", deadline)
+        self.uart = connect_unix(f"{self.work}/uart.sock", deadline, self.qemu)
         self.uart.setblocking(False)
         with open(f"{self.work}/clock.bin", "r+b") as f:
             self.clock = mmap.mmap(f.fileno(), 4096)
@@ -324,6 +332,15 @@ class Harness:
 
     def finish(self):
         ram = None
+        if self.log is None:  # QEMU never came up: nothing recorded
+            if self.qemu is not None and self.qemu.poll() is None:
+                self.qemu.kill()
+                self.qemu.wait()
+            if os.path.exists(f"{self.work}/qemu.stderr"):
+                sys.stderr.write(open(f"{self.work}/qemu.stderr").read())
+            self.waveform.discard()
+            shutil.rmtree(self.work, ignore_errors=True)
+            return
         try:
             monitor(self.work, ["stop", f'memsave {RAM_BASE:#x} {RAM_SIZE} "{self.work}/ram.bin"',
                                 "quit"], time.monotonic() + 10)
@@ -339,8 +356,9 @@ class Harness:
             write_measures(self.args, self, ram)
         if self.client is not None:
             self.client.close()
-        self.listener.close()
-        os.unlink(self.args.uart_socket)
+        if self.listener is not None:
+            self.listener.close()
+            os.unlink(self.args.uart_socket)
         if self.args.keep and os.path.exists(f"{self.work}/ram.bin"):
             shutil.copy(f"{self.work}/ram.bin", self.args.waveform + ".ram")
         if not self.args.keep:
