@@ -59,7 +59,7 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_version = 1;
 
 enum { kGpioBase = 0x50000000u, kGpioSize = 0x1000u };
 
-static uint64_t g_private_count; /* until the clock file is mapped */
+static uint64_t g_private_count;                      /* until the clock file is mapped */
 static volatile uint64_t* g_count = &g_private_count; /* one vCPU (nRF51) */
 
 static void OnStore(unsigned int vcpu_index, qemu_plugin_meminfo_t info, uint64_t vaddr,
