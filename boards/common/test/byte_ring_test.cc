@@ -54,6 +54,25 @@ TEST(ByteRing, TheLargestRingHoldsAllItsBytes) {
   EXPECT_EQ(ring.Size(), 128);
 }
 
+TEST(ByteRing, ASixteenBitIndexHoldsALargeRingAcrossWraps) {
+  ByteRing<2048, std::uint16_t> ring;
+  for (int k = 0; k < 2048; ++k) ASSERT_TRUE(ring.Push(static_cast<std::uint8_t>(k * 7)));
+  EXPECT_FALSE(ring.Push(0));
+  EXPECT_EQ(ring.Size(), 2048);
+  // 40 rounds of 2000 bytes: the 16-bit indices wrap past 65535.
+  std::uint32_t in = 2048;
+  std::uint32_t out = 0;
+  for (int round = 0; round < 40; ++round) {
+    std::uint8_t byte = 0;
+    for (int k = 0; k < 2000; ++k) {
+      ASSERT_TRUE(ring.Pop(&byte));
+      ASSERT_EQ(byte, static_cast<std::uint8_t>(out++ * 7));
+    }
+    for (int k = 0; k < 2000; ++k) ASSERT_TRUE(ring.Push(static_cast<std::uint8_t>(in++ * 7)));
+  }
+  EXPECT_EQ(ring.overruns(), 1);
+}
+
 std::vector<std::uint8_t> g_sent;
 struct RecordingUart {
   static void Send(const std::uint8_t* data, std::size_t size) {
@@ -63,7 +82,7 @@ struct RecordingUart {
 
 TEST(UartTransport, ReadsWhatTheRingHoldsAndNeverWaits) {
   ByteRing<16> rx;
-  UartTransport<16, RecordingUart> link(rx);
+  UartTransport<ByteRing<16>, RecordingUart> link(rx);
   std::uint8_t buffer[4];
   std::size_t got = 99;
   EXPECT_EQ(link.Read(buffer, sizeof buffer, &got, 1000), hal::IoStatus::kTimeout);
@@ -81,7 +100,7 @@ TEST(UartTransport, ReadsWhatTheRingHoldsAndNeverWaits) {
 
 TEST(UartTransport, WritesGoToTheUart) {
   ByteRing<16> rx;
-  UartTransport<16, RecordingUart> link(rx);
+  UartTransport<ByteRing<16>, RecordingUart> link(rx);
   g_sent.clear();
   const std::uint8_t frame[] = {1, 2, 3, 0};
   ASSERT_EQ(link.Write(frame, sizeof frame, 100), hal::IoStatus::kOk);

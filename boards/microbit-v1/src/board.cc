@@ -9,10 +9,11 @@
 #include <stdint.h>
 
 #include "board_stats.h"
+#include "fdsurf/board/byte_ring.h"
+#include "fdsurf/board/uart_transport.h"
 #include "fdsurf/device/device.h"
 #include "nrf51.h"
 #include "pins.h"
-#include "rx_ring.h"
 
 #ifndef FDSURF_MICROBIT_TICK_HZ
 #define FDSURF_MICROBIT_TICK_HZ 20000
@@ -125,10 +126,14 @@ class PinOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
 // walk over the buffer at each pen event costs ~32 cycles per entry in the
 // tick (README.md, measures), so a longer buffer costs late ticks there.
 constexpr int kLookahead = 256;
+// The M0 validates a PATCH in up to ~80 ms (README.md), while 115200 baud
+// brings ~950 bytes: a 128-byte ring dropped 482 bytes of a 5-command job,
+// each loss a NAK or a timeout and a resend. 2 KB holds them all.
 constexpr uint16_t kRxRingBytes = 2048;
+using RxRing = ByteRing<kRxRingBytes, uint16_t>;
 using BoardDevice = device::Device<2, 8, kLookahead, PrimaskLock>;
 
-RxRing<kRxRingBytes> g_rx;
+RxRing g_rx;
 BoardDevice g_device(kTickHz);
 PinOutputs g_outputs;
 uint32_t g_next_compare;
@@ -284,7 +289,7 @@ void fdsurf_board_main() {
   SetUpPins();
   SetUpClock();
   SetUpUart();
-  RingTransport<kRxRingBytes, Uart> link(g_rx);
+  UartTransport<RxRing, Uart> link(g_rx);
   SetUpTimer();
   for (;;) ServiceOnce(link);
 }

@@ -6,7 +6,7 @@
 //
 //   struct Uart { static void Send(const uint8_t* data, size_t size); };
 //   board::ByteRing<64> rx;              // ISR: rx.Push(UDR0)
-//   board::UartTransport<64, Uart> link(rx);
+//   board::UartTransport<board::ByteRing<64>, Uart> link(rx);
 //   for (;;) { device.Service(link); device.Fill(); }
 //
 // A UART cannot tell that the other end went away, so this transport never
@@ -22,10 +22,10 @@
 namespace fdsurf {
 namespace board {
 
-template <uint8_t kRxCapacity, class Uart>
+template <class Ring, class Uart>
 class UartTransport final : public hal::Transport {
  public:
-  explicit UartTransport(ByteRing<kRxCapacity>& rx) : rx_(rx) {}
+  explicit UartTransport(Ring& rx) : rx_(rx) {}
   ~UartTransport() = default;
 
  private:
@@ -49,7 +49,7 @@ class UartTransport final : public hal::Transport {
   hal::IoStatus DoReconnect(uint32_t) override { return hal::IoStatus::kOk; }
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
 
-  ByteRing<kRxCapacity>& rx_;
+  Ring& rx_;
 };
 
 }  // namespace board
