@@ -166,6 +166,72 @@ TEST(MotionLoop, RandomPathsWithPenEventsAndStarvationKeepTheLimits) {
   }
 }
 
+// The length of each run between pen events is kept as it is pushed (a
+// ring of kMaxPenEvents runs), not recounted when a pen event is passed: a
+// run must take the same ticks whether it was the head run when pushed or
+// was pushed behind pen events, and the same as the same run alone.
+TEST(MotionLoop, RunsBehindPenEventsTakeTheTicksOfTheSameRunAlone) {
+  std::vector<std::uint8_t> storage(1024);
+  const std::int32_t right[2] = {1, 0};
+  const std::int32_t diagonal[2] = {1, 1};
+  // Runs of different lengths and move kinds, so that a length credited
+  // to the wrong run changes some run's time.
+  const int lengths[] = {150, 40, 300, 7, 90};
+  std::vector<std::uint8_t> alone_storage(1024);
+  const auto alone = [&](int steps, const std::int32_t* delta) {
+    MotionLoop loop(alone_storage.data(), 1024);
+    loop.Configure(Limits(8000, 160000));
+    for (int i = 0; i < steps; ++i) EXPECT_TRUE(loop.Push(MakeMove(delta, 2)));
+    EXPECT_TRUE(loop.Push(MakeEntry(EntryKind::kPenUp)));
+    std::uint64_t ticks = 0;
+    while (loop.position()[0] < steps && ticks < 1'000'000) {
+      (void)loop.Tick();
+      ++ticks;
+    }
+    return ticks;
+  };
+  MotionLoop loop(storage.data(), 1024);
+  loop.Configure(Limits(8000, 160000));
+  std::vector<std::uint8_t> entries;
+  for (int k = 0; k < 5; ++k) {
+    for (int i = 0; i < lengths[k]; ++i) entries.push_back(MakeMove(k % 2 ? diagonal : right, 2));
+    entries.push_back(MakeEntry(k % 2 ? EntryKind::kPenUp : EntryKind::kPenDown));
+  }
+  // Everything the cap allows goes in at once, the rest as room appears.
+  std::size_t next = 0;
+  const auto feed = [&] {
+    while (next < entries.size() && !loop.Full()) ASSERT_TRUE(loop.Push(entries[next++]));
+  };
+  feed();
+  EXPECT_LT(next, entries.size()) << "the pen-event cap never held anything back";
+  std::int32_t start = 0;
+  for (int k = 0; k < 5; ++k) {
+    std::uint64_t ticks = 0;
+    while (loop.position()[0] < start + lengths[k] && ticks < 1'000'000) {
+      (void)loop.Tick();
+      feed();
+      ++ticks;
+    }
+    start += lengths[k];
+    ASSERT_EQ(ticks, alone(lengths[k], k % 2 ? diagonal : right)) << "run " << k;
+    for (int t = 0; t < 10 && loop.pen_down() != (k % 2 == 0); ++t) (void)loop.Tick();
+    ASSERT_EQ(loop.pen_down(), k % 2 == 0) << "pen event " << k << " not passed";
+  }
+}
+
+TEST(MotionLoop, HoldsAtMostItsPenEventsAtOnce) {
+  std::vector<std::uint8_t> storage(64);
+  MotionLoop loop(storage.data(), 64);
+  loop.Configure(Limits(8000, 160000));
+  for (int k = 0; k < MotionLoop::kMaxPenEvents; ++k) {
+    ASSERT_FALSE(loop.Full());
+    ASSERT_TRUE(loop.Push(MakeEntry(k % 2 ? EntryKind::kPenUp : EntryKind::kPenDown)));
+  }
+  EXPECT_TRUE(loop.Full());
+  EXPECT_FALSE(loop.Push(MakeEntry(EntryKind::kPenUp)));
+  EXPECT_EQ(loop.Count(), MotionLoop::kMaxPenEvents);
+}
+
 TEST(MotionLoop, StopDeceleratesAlongThePathWithinTheLimit) {
   std::vector<std::uint8_t> storage(4096);
   MotionLoop loop(storage.data(), 4096);

@@ -30,14 +30,16 @@ uint32_t MotionLoop::LengthOf(uint8_t move) {
 }
 
 bool MotionLoop::Push(uint8_t entry) {
-  if (count_ == capacity_) return false;
+  if (Full()) return false;
   storage_[(head_ + count_) & mask_] = entry;
   ++count_;
   const EntryKind kind = KindOf(entry);
   if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) {
+    runs_[(first_run_ + stops_) % kMaxPenEvents] = 0;
     ++stops_;
-  } else if (kind == EntryKind::kMove && stops_ == 0) {
-    distance_ += LengthOf(entry);
+  } else if (kind == EntryKind::kMove) {
+    uint64_t& run = stops_ == 0 ? distance_ : runs_[(first_run_ + stops_ - 1) % kMaxPenEvents];
+    run += LengthOf(entry);
   }
   return true;
 }
@@ -47,20 +49,11 @@ void MotionLoop::Pop() {
   --count_;
 }
 
-void MotionLoop::RecomputeDistance() {
-  distance_ = 0;
-  for (uint16_t i = 0; i < count_; ++i) {
-    const uint8_t entry = At(i);
-    const EntryKind kind = KindOf(entry);
-    if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) break;
-    if (kind == EntryKind::kMove) distance_ += LengthOf(entry);
-  }
-}
-
 void MotionLoop::Clear() {
   head_ = 0;
   count_ = 0;
   stops_ = 0;
+  first_run_ = 0;
   distance_ = 0;
   phase_ = 0;
   speed_ = 0;
@@ -95,11 +88,13 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     }
     // A pen event is only reached with no distance left before it, where the
     // profile guarantees speed ≤ a; stopping from there is one deceleration.
+    // The run after this pen event becomes the head run.
     --stops_;
     speed_ = 0;
     braking_ = 0;
     phase_ = 0;
-    RecomputeDistance();
+    distance_ = runs_[first_run_];
+    first_run_ = static_cast<uint8_t>((first_run_ + 1) % kMaxPenEvents);
     const bool down = kind == EntryKind::kPenDown;
     if (down != pen_down_) {
       pen_down_ = down;
