@@ -8,9 +8,10 @@ as /dev/serial/by-id/... names a USB serial port) and forwards bytes both ways.
 On a schedule it can misbehave as a real line does:
 
   --hangup-after N --hangup-for S   after N bytes towards the board, close the
-                                    pty (the host sees a hang-up, as on an
-                                    unplug), wait S seconds, create a new pty
-                                    and re-point LINK at it (the board replugged)
+                                    pty and remove LINK (the host sees a
+                                    hang-up, as on an unplug), wait S seconds,
+                                    create a new pty and point LINK at it (the
+                                    board replugged)
   --corrupt-after N --corrupt-bytes K
                                     once, after N bytes towards the board,
                                     flip every bit of the next K bytes
@@ -117,6 +118,7 @@ class Relay:
         self.hung_up = True
         self.pty.close()
         self.pty = None
+        os.unlink(self.args.link)  # as udev removes /dev/serial/by-id/... on an unplug
         self.replug_at = time.monotonic() + self.args.hangup_for
         log("hung up after %d bytes towards the board; back in %.1f s" %
             (self.to_board, self.args.hangup_for))
