@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 // The commands of the fdsurf tool, one file each: sample_command.cc,
 // check_command.cc, plot_command.cc (plot and render), stream_command.cc,
-// construct_commands.cc (joins). Each Run* returns the exit code: 0 done,
+// construct_commands.cc (joins), ports_command.cc. Each Run* returns the exit code: 0 done,
 // 1 a bound broken, 2 bad input; they throw InputError, OptionError,
 // OutputError and EngineError, which fdsurf.cc reports.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cli_options.h"
 #include "fdsurf/host/writers.h"
@@ -43,6 +45,21 @@ struct PlotOptions {
   bool quiet = false;
   GcodeOptions gcode;
 };
+
+struct PortsOptions {
+  std::vector<std::string> paths;
+  bool probe = false;
+  std::uint32_t baud = 115200;
+  double timeout_s = 3;
+};
+
+/// Adds the options of `ports`.
+void AddPortsOptions(CLI::App* command, PortsOptions* options);
+
+/// `ports`: a table of the serial ports (and the PATHs given), with --probe
+/// what answered HELLO on each. 0, or 3 for a PATH that does not exist, or
+/// when --probe found no port that answers.
+int RunPorts(const PortsOptions& options);
 
 /// Adds the options of `plot` (or, with `render_only`, of `render`).
 void AddPlotOptions(CLI::App* command, PlotOptions* options, bool render_only);

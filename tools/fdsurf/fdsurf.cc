@@ -25,12 +25,14 @@ struct Commands {
   PlotOptions render_options;
   StreamOptions stream_options;
   JoinsOptions joins_options;
+  PortsOptions ports_options;
   CLI::App* sample = nullptr;
   CLI::App* check = nullptr;
   CLI::App* plot = nullptr;
   CLI::App* render = nullptr;
   CLI::App* stream = nullptr;
   CLI::App* joins = nullptr;
+  CLI::App* ports = nullptr;
 };
 
 void AddCommands(CLI::App* app, Commands* c) {
@@ -60,6 +62,11 @@ void AddCommands(CLI::App* app, Commands* c) {
   c->joins = app->add_subcommand(
       "joins", "Report for every shared edge of the patches whether the join is C0, G1 or C1.");
   AddJoinsOptions(c->joins, &c->joins_options);
+  c->ports = app->add_subcommand(
+      "ports",
+      "List the serial ports (USB VID:PID, serial number, product); --probe asks each "
+      "for the fdsurf firmware.");
+  AddPortsOptions(c->ports, &c->ports_options);
 }
 
 // CLI11 would only say "a subcommand is required" for a mistyped command.
@@ -67,7 +74,7 @@ bool IsUnknownCommand(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return false;
   const std::string first = argv[1];
   return first != "sample" && first != "check" && first != "plot" && first != "render" &&
-         first != "stream" && first != "joins";
+         first != "stream" && first != "joins" && first != "ports";
 }
 
 // Runs the parsed command; the library's errors become messages and exit
@@ -80,6 +87,7 @@ int RunParsed(const Commands& c) {
     if (c.render->parsed()) return RunPlot(c.render_options, true);
     if (c.stream->parsed()) return RunStream(c.stream_options);
     if (c.joins->parsed()) return RunJoins(c.joins_options);
+    if (c.ports->parsed()) return RunPorts(c.ports_options);
   } catch (const OptionError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.MessageFor(FlagFor(e.field())).c_str());
     return 2;
@@ -108,8 +116,8 @@ int Main(int argc, char** argv) {
   if (IsUnknownCommand(argc, argv)) {
     std::fprintf(
         stderr,
-        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream or "
-        "joins)\n",
+        "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream, "
+        "joins or ports)\n",
         argv[1]);
     return 2;
   }

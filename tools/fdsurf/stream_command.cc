@@ -9,6 +9,7 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
 #include "runners/runner.h"
+#include "runners/serial_session.h"
 
 namespace fdsurf::host {
 namespace {
@@ -62,7 +63,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->required();
   command
       ->add_option("--device", o->device,
-                   "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT] or "
+                   "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
+                   "serial:PATH[:BAUD] (e.g. serial:/dev/ttyACM0:115200), serial:auto or "
                    "gpio:CHIP:STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN")
       ->capture_default_str();
   command
@@ -106,6 +108,17 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                    "probability (0..0.5)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
+  command
+      ->add_option("--connect-timeout", o->connect_timeout_s,
+                   "usb, serial: seconds to retry HELLO before giving up (a board reset by "
+                   "opening its port is silent 1-2 s)")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  command
+      ->add_option("--reconnect-timeout", o->reconnect_timeout_s,
+                   "usb, serial: seconds a device that hung up may take to come back")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
   command->add_option("--seed", o->seed, "sim: seed of the fault injection")->capture_default_str();
   command
       ->add_option("--sim-cost", o->sim_cost,
@@ -126,9 +139,11 @@ int RunStream(const StreamOptions& o) {
   const bool sim = o.device == "sim";
   const bool usb = o.device == "usb" || o.device.rfind("usb:", 0) == 0;
   const bool gpio = o.device.rfind("gpio:", 0) == 0;
-  if (!sim && !usb && !gpio) {
+  const bool serial = o.device.rfind("serial:", 0) == 0;
+  if (!sim && !usb && !gpio && !serial) {
     throw InputError("--device: '" + o.device +
-                     "' is not sim, usb[:VID:PID|:BUS-PORT] or gpio:CHIP:LINES");
+                     "' is not sim, usb[:VID:PID|:BUS-PORT], serial:PATH[:BAUD], serial:auto or "
+                     "gpio:CHIP:LINES");
   }
   if (!sim && (!o.svg.empty() || !o.png.empty() || !o.waveform.empty() || o.faults > 0 ||
                o.sim_cost != "none")) {
@@ -147,6 +162,7 @@ int RunStream(const StreamOptions& o) {
   try {
     if (sim) return RunSimulated(o, set, job, scaled, o.units);
     if (usb) return RunUsb(o, job);
+    if (serial) return RunSerial(o, job);
     return RunGpio(o, job);
   } catch (const DeviceError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());

@@ -33,6 +33,10 @@ struct StreamOptions {
   // The link and the simulator.
   std::uint64_t link_bytes_per_second = 1'000'000;
   double faults = 0;
+  /// usb, serial: how long HELLO is retried, and how long a device that
+  /// hung up may take to come back, seconds.
+  double connect_timeout_s = 10;
+  double reconnect_timeout_s = 30;
   /// sim: what the device's validation costs in virtual time: "none" or
   /// "atmega2560" (16 MHz, the cycles measured under simavr).
   std::string sim_cost = "none";

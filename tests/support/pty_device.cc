@@ -1,0 +1,263 @@
+// SPDX-License-Identifier: MIT
+// A serial device for tests, on a real kernel pseudo-terminal: the firmware's
+// Device<2> runs here on the pty's master side and the slave is published
+// under a stable symlink, which the host opens as `serial:LINK`.
+//
+//   pty_device --link PATH [--report FILE] [--tick-hz 20000] [--speedup 1]
+//              [--silent-ms N] [--never-answer] [--hangup-after-bytes N]
+//              [--back-after-ms M] [--time-limit-s S]
+//
+// --silent-ms N          a board reset by DTR: from the first byte the host
+//                        sends, N ms of bytes are read and ignored (the
+//                        bootloader), then the firmware answers.
+// --never-answer         reads everything, answers nothing.
+// --hangup-after-bytes N after N bytes received, closes the pty (the host
+//                        sees a hang-up); after --back-after-ms M (500) it
+//                        opens a new pty and points the symlink at it. The
+//                        Device keeps its state and keeps moving meanwhile.
+// --speedup K            K device ticks of 1/tick-hz s per real 1/tick-hz s.
+//
+// Prints "ready" once the link exists. On SIGTERM, SIGINT or the time limit
+// (30 s) it writes the report (key value lines: executed commands, steps per
+// axis, a digest of every step and pen change in order, stops received,
+// HELLOs, duplicates, pen state, whether it was at rest) and exits 0.
+#include <fcntl.h>
+#include <poll.h>
+#include <pty.h>
+#include <signal.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "fdsurf/device/device.h"
+#include "fdsurf/hal/outputs.h"
+
+namespace {
+
+volatile sig_atomic_t g_quit = 0;
+void OnSignal(int) { g_quit = 1; }
+
+struct Options {
+  std::string link;
+  std::string report;
+  uint32_t tick_hz = 20000;
+  double speedup = 1;
+  long silent_ms = 0;
+  bool never_answer = false;
+  long hangup_after_bytes = -1;
+  long back_after_ms = 500;
+  double time_limit_s = 30;
+};
+
+// Counts steps per axis and folds every step and pen change, in order, into
+// an FNV-1a digest: two runs that executed the same commands once each have
+// the same digest.
+class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf::hal::PenOutput {
+ public:
+  RecordingOutputs() : StepDirOutputs(2) {}
+  uint64_t steps[3] = {0, 0, 0};
+  uint64_t digest = 1469598103934665603ull;
+  bool pen_down = false;
+
+ private:
+  void Fold(uint8_t byte) {
+    digest ^= byte;
+    digest *= 1099511628211ull;
+  }
+  fdsurf::hal::IoStatus DoSetEnabled(bool) override { return fdsurf::hal::IoStatus::kOk; }
+  fdsurf::hal::IoStatus DoSetDirections(uint8_t negative_mask) override {
+    negative_ = negative_mask;
+    return fdsurf::hal::IoStatus::kOk;
+  }
+  fdsurf::hal::IoStatus DoStep(uint8_t axis_mask) override {
+    for (int a = 0; a < 3; ++a) steps[a] += (axis_mask >> a) & 1u;
+    Fold(static_cast<uint8_t>(axis_mask | (negative_ & axis_mask) << 4));
+    return fdsurf::hal::IoStatus::kOk;
+  }
+  fdsurf::hal::IoStatus DoSetPen(bool down) override {
+    pen_down = down;
+    Fold(down ? 0x81 : 0x80);
+    return fdsurf::hal::IoStatus::kOk;
+  }
+  const char* DoLastError() const override { return ""; }
+  uint8_t negative_ = 0;
+};
+
+bool ParseOptions(int argc, char** argv, Options* o) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (arg == "--never-answer") {
+      o->never_answer = true;
+    } else if (arg == "--link" && has_value) {
+      o->link = argv[++i];
+    } else if (arg == "--report" && has_value) {
+      o->report = argv[++i];
+    } else if (arg == "--tick-hz" && has_value) {
+      o->tick_hz = static_cast<uint32_t>(std::strtoul(argv[++i], nullptr, 10));
+    } else if (arg == "--speedup" && has_value) {
+      o->speedup = std::strtod(argv[++i], nullptr);
+    } else if (arg == "--silent-ms" && has_value) {
+      o->silent_ms = std::strtol(argv[++i], nullptr, 10);
+    } else if (arg == "--hangup-after-bytes" && has_value) {
+      o->hangup_after_bytes = std::strtol(argv[++i], nullptr, 10);
+    } else if (arg == "--back-after-ms" && has_value) {
+      o->back_after_ms = std::strtol(argv[++i], nullptr, 10);
+    } else if (arg == "--time-limit-s" && has_value) {
+      o->time_limit_s = std::strtod(argv[++i], nullptr);
+    } else {
+      std::fprintf(stderr, "pty_device: unknown or incomplete option '%s'\n", arg.c_str());
+      return false;
+    }
+  }
+  if (o->link.empty() || o->tick_hz == 0 || !(o->speedup > 0)) {
+    std::fprintf(stderr, "pty_device: --link PATH is required; --tick-hz, --speedup > 0\n");
+    return false;
+  }
+  return true;
+}
+
+// One pty, its slave kept open here too (so the master never sees the host's
+// close as a hang-up), published at `link` by an atomic rename.
+struct Pty {
+  int master = -1;
+  int slave = -1;
+
+  bool Open(const std::string& link) {
+    char name[128];
+    if (openpty(&master, &slave, name, nullptr, nullptr) != 0) {
+      std::perror("pty_device: openpty");
+      return false;
+    }
+    termios tio{};
+    tcgetattr(slave, &tio);
+    cfmakeraw(&tio);
+    tcsetattr(slave, TCSANOW, &tio);
+    fcntl(master, F_SETFL, fcntl(master, F_GETFL) | O_NONBLOCK);
+    const std::string temporary = link + ".new";
+    unlink(temporary.c_str());
+    if (symlink(name, temporary.c_str()) != 0 || rename(temporary.c_str(), link.c_str()) != 0) {
+      std::perror("pty_device: publishing the link");
+      return false;
+    }
+    return true;
+  }
+  void Close() {
+    if (slave >= 0) close(slave);
+    if (master >= 0) close(master);
+    master = slave = -1;
+  }
+};
+
+using Clock = std::chrono::steady_clock;
+
+long MsSince(Clock::time_point t) {
+  return static_cast<long>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t).count());
+}
+
+struct Run {
+  const Options& o;
+  fdsurf::device::Device<2> device;
+  RecordingOutputs outputs;
+  Pty pty;
+  long bytes_in = 0;
+  bool heard = false;  // a first byte arrived: the "reset" happened
+  Clock::time_point first_byte;
+  bool down = false;  // hung up, waiting to come back
+  Clock::time_point down_since;
+  uint64_t ticks_done = 0;
+
+  explicit Run(const Options& options) : o(options), device(options.tick_hz) {}
+
+  // Bytes in from the host, replies out.
+  void Service() {
+    uint8_t buffer[256];
+    const ssize_t n = pty.master >= 0 ? read(pty.master, buffer, sizeof buffer) : -1;
+    for (ssize_t i = 0; i < n; ++i) {
+      if (!heard) {
+        heard = true;
+        first_byte = Clock::now();
+      }
+      ++bytes_in;
+      const bool silent = o.never_answer || MsSince(first_byte) < o.silent_ms;
+      if (!silent) device.OnByte(buffer[i]);
+      if (o.hangup_after_bytes >= 0 && bytes_in == o.hangup_after_bytes && !down) {
+        pty.Close();
+        unlink(o.link.c_str());
+        down = true;
+        down_since = Clock::now();
+        break;
+      }
+    }
+    for (size_t got; (got = device.ReadOutput(buffer, sizeof buffer)) > 0;) {
+      if (pty.master >= 0) (void)!write(pty.master, buffer, got);
+    }
+    if (down && MsSince(down_since) >= o.back_after_ms) {
+      down = false;
+      if (!pty.Open(o.link)) g_quit = 1;
+    }
+  }
+
+  // The ticks that are due by now, at the speed-up.
+  void Tick(Clock::time_point start) {
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const auto due = static_cast<uint64_t>(elapsed * o.tick_hz * o.speedup);
+    for (int budget = 4096; ticks_done < due && budget > 0; --budget, ++ticks_done) {
+      (void)device.Tick(outputs, outputs);
+    }
+    ticks_done = std::max(ticks_done, due > 100000 ? due - 100000 : 0);
+  }
+
+  void Report() const {
+    if (o.report.empty()) return;
+    FILE* f = std::fopen(o.report.c_str(), "w");
+    if (f == nullptr) return;
+    const auto& stats = device.link_stats();
+    std::fprintf(f, "executed %u\nsteps_x %llu\nsteps_y %llu\ndigest %016llx\n", device.executed(),
+                 static_cast<unsigned long long>(outputs.steps[0]),
+                 static_cast<unsigned long long>(outputs.steps[1]),
+                 static_cast<unsigned long long>(outputs.digest));
+    std::fprintf(f, "stops %u\nhellos %u\nduplicates %u\naccepted %u\npen_down %d\nidle %d\n",
+                 stats.stops, stats.hellos, stats.duplicates, stats.commands_accepted,
+                 outputs.pen_down ? 1 : 0, device.Idle() ? 1 : 0);
+    std::fprintf(f, "bytes_in %ld\n", bytes_in);
+    std::fclose(f);
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (!ParseOptions(argc, argv, &o)) return 2;
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  auto run = std::make_unique<Run>(o);
+  if (!run->pty.Open(o.link)) return 1;
+  std::printf("ready\n");
+  std::fflush(stdout);
+  const Clock::time_point start = Clock::now();
+  while (g_quit == 0 &&
+         std::chrono::duration<double>(Clock::now() - start).count() < o.time_limit_s) {
+    pollfd p{run->pty.master, POLLIN, 0};
+    (void)poll(&p, run->pty.master >= 0 ? 1 : 0, 1);
+    run->Service();
+    run->device.Fill();
+    run->Tick(start);
+  }
+  run->Report();
+  run->pty.Close();
+  unlink(o.link.c_str());
+  return 0;
+}

@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: MIT
+#include "transport_loop.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "fdsurf/hal/monotonic_clock.h"
+#include "fdsurf/protocol/codec.h"
+
+namespace fdsurf::host {
+namespace {
+
+volatile sig_atomic_t g_interrupts = 0;
+struct sigaction g_previous_int {};
+struct sigaction g_previous_term {};
+
+void OnInterrupt(int) {
+  g_interrupts = g_interrupts + 1;
+  if (g_interrupts >= 2) {
+    static const char kMessage[] = "\nfdsurf: interrupted again: exiting at once\n";
+    (void)!write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+    _exit(130);
+  }
+}
+
+std::string Seconds(std::uint64_t us) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f s", static_cast<double>(us) * 1e-6);
+  return text;
+}
+
+const char* StateName(protocol::DeviceState state) {
+  switch (state) {
+    case protocol::DeviceState::kIdle:
+      return "idle";
+    case protocol::DeviceState::kRunning:
+      return "running";
+    case protocol::DeviceState::kStopping:
+      return "stopping";
+    case protocol::DeviceState::kFault:
+      return "fault";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+InterruptGuard::InterruptGuard() {
+  g_interrupts = 0;
+  struct sigaction action {};
+  action.sa_handler = OnInterrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: a wait in poll() ends at once
+  sigaction(SIGINT, &action, &g_previous_int);
+  sigaction(SIGTERM, &action, &g_previous_term);
+}
+
+InterruptGuard::~InterruptGuard() {
+  sigaction(SIGINT, &g_previous_int, nullptr);
+  sigaction(SIGTERM, &g_previous_term, nullptr);
+}
+
+bool InterruptGuard::Interrupted() { return g_interrupts != 0; }
+
+TransportLoop::TransportLoop(hal::Transport& transport, TransportLoopOptions options)
+    : transport_(transport), options_(std::move(options)), link_(LinkOptions()) {}
+
+void TransportLoop::Reconnect() {
+  if (!options_.quiet) {
+    std::fprintf(stderr, "\nfdsurf: %s; waiting up to %s for it to come back\n",
+                 transport_.LastError(), Seconds(options_.reconnect_timeout_ms * 1000ull).c_str());
+  }
+  // In slices, so that Ctrl-C is noticed while the device is away.
+  const std::uint64_t deadline =
+      hal::MonotonicClock::Now() + options_.reconnect_timeout_ms * 1000ull;
+  while (true) {
+    const std::uint64_t now = hal::MonotonicClock::Now();
+    const auto slice = static_cast<std::uint32_t>(now >= deadline ? 0 : (deadline - now) / 1000);
+    const hal::IoStatus status = transport_.Reconnect(std::min<std::uint32_t>(slice, 250));
+    if (status == hal::IoStatus::kOk) break;
+    if (status != hal::IoStatus::kTimeout) throw DeviceError(transport_.LastError());
+    if (now >= deadline) {
+      throw DeviceError(options_.device + ": lost and not back within " +
+                        Seconds(options_.reconnect_timeout_ms * 1000ull) + "; gave up");
+    }
+    if (InterruptGuard::Interrupted()) {
+      throw DeviceError(options_.device +
+                        ": interrupted while the device was away: STOP could not be sent, so it "
+                        "may still be moving");
+    }
+  }
+  ++reconnects_;
+  if (!options_.quiet)
+    std::fprintf(stderr, "fdsurf: %s is back; resuming\n", options_.device.c_str());
+  link_.Resume();
+}
+
+void TransportLoop::Turn() {
+  const std::uint64_t now = hal::MonotonicClock::Now();
+  std::uint8_t in[512];
+  std::size_t got = 0;
+  hal::IoStatus status = transport_.Read(in, sizeof in, &got, 2);
+  if (status == hal::IoStatus::kOk) {
+    link_.OnBytes(in, got, now);
+    for (std::size_t i = 0; tap_ && i < got; ++i) {
+      protocol::Reply reply;
+      if (!tap_decoder_.OnByte(in[i]) || !tap_decoder_.frame().in_session) continue;
+      if (protocol::DecodeReply(tap_decoder_.frame(), &reply).ok() &&
+          reply.type == protocol::MessageType::kStatusReport && reply.seq == rest_token_) {
+        rest_report_ = reply.body.status;
+      }
+    }
+  }
+  out_.clear();
+  link_.Poll(now, &out_);
+  if (status != hal::IoStatus::kDisconnected && !out_.empty()) {
+    status = transport_.Write(out_.data(), out_.size(), 1000);
+  }
+  if (status == hal::IoStatus::kDisconnected) {
+    Reconnect();
+  } else if (status != hal::IoStatus::kOk && status != hal::IoStatus::kTimeout) {
+    throw DeviceError(transport_.LastError());
+  }
+}
+
+bool TransportLoop::Connect() {
+  const std::uint64_t start = hal::MonotonicClock::Now();
+  while (!link_.Connected()) {
+    if (InterruptGuard::Interrupted()) return false;
+    if (link_.Failed())
+      throw DeviceError(options_.device + ": " + DecodeDeviceError(link_.error()));
+    const std::uint64_t waited = hal::MonotonicClock::Now() - start;
+    if (waited >= options_.connect_timeout_ms * 1000ull) {
+      throw DeviceError(options_.device + ": no answer to HELLO within " + Seconds(waited) + " (" +
+                        std::to_string(link_.stats().hellos_sent) +
+                        " sent): is it the right port and baud, and is the fdsurf firmware on "
+                        "the board? (docs/serial.md)");
+    }
+    Turn();
+  }
+  return true;
+}
+
+int TransportLoop::Run(const StreamJob& job, ProgressLine* progress) {
+  Enqueue(job, &link_);
+  std::uint64_t last_progress = 0;
+  while (!link_.Finished() && !link_.Failed()) {
+    if (InterruptGuard::Interrupted()) {
+      progress->Finish();
+      return StopAndReport(job.commands.size());
+    }
+    Turn();
+    const std::uint64_t now = hal::MonotonicClock::Now();
+    if (now - last_progress > 250'000) {
+      last_progress = now;
+      progress->Show(link_.status() ? link_.status()->executed : 0, job.commands.size(),
+                     link_.stats().frames_sent, 0);
+    }
+  }
+  progress->Finish();
+  if (link_.Failed()) throw DeviceError(options_.device + ": " + DecodeDeviceError(link_.error()));
+  return 0;
+}
+
+bool TransportLoop::AtRest(std::uint64_t now_us, std::string* state) {
+  if (rest_report_) {
+    *state = StateName(rest_report_->state);
+    if (rest_report_->state == protocol::DeviceState::kIdle ||
+        rest_report_->state == protocol::DeviceState::kFault) {
+      return true;
+    }
+  }
+  if (now_us - rest_query_us_ >= 100'000) {
+    rest_query_us_ = now_us;
+    rest_report_.reset();
+    rest_token_ = static_cast<std::uint16_t>(rest_token_ == 0xFFFF ? 0xFF00 : rest_token_ + 1);
+    tap_decoder_.set_session(link_.session());
+    std::array<std::uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+    const std::size_t size =
+        protocol::EncodeStatusQuery(rest_token_, frame.data(), frame.size(), link_.session());
+    (void)transport_.Write(frame.data(), size, 100);
+  }
+  return false;
+}
+
+int TransportLoop::StopAndReport(std::uint64_t total_commands) {
+  if (!options_.quiet) std::fprintf(stderr, "fdsurf: interrupted: stopping the device\n");
+  link_.RequestStop();
+  tap_ = true;
+  const std::uint64_t deadline = hal::MonotonicClock::Now() + options_.stop_timeout_ms * 1000ull;
+  std::string state = "unknown";
+  bool rest = false;
+  while (hal::MonotonicClock::Now() < deadline && !link_.Failed()) {
+    Turn();
+    if (link_.StopAcknowledged() && (rest = AtRest(hal::MonotonicClock::Now(), &state))) break;
+  }
+  const std::uint64_t executed = rest_report_ ? rest_report_->executed : 0;
+  if (!link_.StopAcknowledged()) {
+    std::fprintf(stderr,
+                 "fdsurf: error: %s did not acknowledge STOP within %s: it may still be moving\n",
+                 options_.device.c_str(), Seconds(options_.stop_timeout_ms * 1000ull).c_str());
+  } else if (!rest) {
+    std::fprintf(stderr,
+                 "fdsurf: error: %s acknowledged STOP but was not at rest within %s "
+                 "(state %s)\n",
+                 options_.device.c_str(), Seconds(options_.stop_timeout_ms * 1000ull).c_str(),
+                 state.c_str());
+  } else {
+    std::fprintf(stderr,
+                 "fdsurf: stopped: %s is at rest (%s, pen %s) after %llu of %llu commands "
+                 "executed\n",
+                 options_.device.c_str(), state.c_str(), rest_report_->pen_down ? "down" : "up",
+                 static_cast<unsigned long long>(executed),
+                 static_cast<unsigned long long>(total_commands));
+  }
+  return 130;
+}
+
+std::uint32_t Milliseconds(double seconds) {
+  return static_cast<std::uint32_t>(std::ceil(std::clamp(seconds, 0.0, 4.0e6) * 1000.0));
+}
+
+StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello,
+                         const std::string& device, const StreamOptions& o) {
+  if (hello.max_axes < job.config.axes) {
+    throw DeviceError(device + ": the device drives " + std::to_string(hello.max_axes) +
+                      " axes; the job needs " + std::to_string(job.config.axes) + " (--dims)");
+  }
+  if (job.config.max_rate <= hello.tick_hz) return job;
+  StreamJob fitted = job;
+  fitted.config.max_rate = hello.tick_hz;
+  for (protocol::Command& command : fitted.commands) {
+    if (command.type == protocol::MessageType::kConfig)
+      command.body.config.max_rate = hello.tick_hz;
+  }
+  if (!o.quiet) {
+    const double lowered = o.speed * hello.tick_hz / job.config.max_rate;
+    std::fprintf(stderr,
+                 "fdsurf: note: %s ticks at %u Hz, one step per tick at most: the speed limit is "
+                 "lowered from %u to %u steps/s (--speed %g %s/s becomes %.4g %s/s)\n",
+                 device.c_str(), hello.tick_hz, job.config.max_rate, hello.tick_hz, o.speed,
+                 o.units.c_str(), lowered, o.units.c_str());
+  }
+  return fitted;
+}
+
+}  // namespace fdsurf::host

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: MIT
+// The real-time loop that the usb and serial runners share: the host link
+// over a hal::Transport (read, HostLink::OnBytes, Poll, write), reconnecting
+// and resuming after a hang-up, the progress line, and Ctrl-C.
+//
+//   TransportLoop loop(transport, {"serial /dev/ttyACM0", ...});
+//   if (!loop.Connect()) return 130;        // HELLO answered, or DeviceError
+//   const StreamJob fitted = FitJobToDevice(job, *loop.link().hello(), ...);
+//   return loop.Run(fitted, &progress);     // 0, or 130 after Ctrl-C
+//
+// Ctrl-C (SIGINT) or SIGTERM: the first sends STOP, waits (bounded) for its
+// acknowledgement and for the device to report itself at rest, says what
+// was executed and makes Run() return 130; a second exits at once (130).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fdsurf/hal/transport.h"
+#include "fdsurf/host/link.h"
+#include "fdsurf/host/stream.h"
+#include "runner.h"
+
+namespace fdsurf::host {
+
+struct TransportLoopOptions {
+  /// How messages name the device: "serial /dev/ttyACM0", "usb 1209:0001".
+  std::string device;
+  /// HELLO is retried (HostLink's retransmission) for this long: a board
+  /// reset by opening its port is silent for 1-2 s first.
+  std::uint32_t connect_timeout_ms = 10'000;
+  /// How long a device that hung up may take to come back.
+  std::uint32_t reconnect_timeout_ms = 30'000;
+  /// After Ctrl-C: how long to wait for STOP's acknowledgement and for rest.
+  std::uint32_t stop_timeout_ms = 10'000;
+  bool quiet = false;
+};
+
+/// SIGINT and SIGTERM counted while it lives (the first is the loop's to
+/// act on; the second exits the process with 130); the previous handlers
+/// come back on destruction.
+class InterruptGuard {
+ public:
+  InterruptGuard();
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+  /// A signal arrived since construction.
+  static bool Interrupted();
+};
+
+class TransportLoop {
+ public:
+  TransportLoop(hal::Transport& transport, TransportLoopOptions options);
+
+  /// Sends HELLO until the device answers. Returns false after Ctrl-C.
+  /// Throws DeviceError naming the device when nothing answers within
+  /// connect_timeout_ms ("serial /dev/ttyACM0: no answer to HELLO within
+  /// 10.0 s (7 sent): ..."), or the transport fails or stays away.
+  bool Connect();
+
+  /// Enqueues the job and runs it to the end: 0, or 130 after Ctrl-C (see
+  /// the top of this file). Throws DeviceError as Connect() does, and when
+  /// the device refuses the job.
+  int Run(const StreamJob& job, ProgressLine* progress);
+
+  FDSURF_NODISCARD HostLink& link() { return link_; }
+  FDSURF_NODISCARD std::uint64_t reconnects() const { return reconnects_; }
+  void set_reconnect_timeout_ms(std::uint32_t ms) { options_.reconnect_timeout_ms = ms; }
+
+ private:
+  // One turn: read (up to 2 ms), hand the bytes over, poll, write;
+  // reconnects and resumes after a hang-up.
+  void Turn();
+  void Reconnect();
+  // After Ctrl-C: STOP, then status until the device is at rest.
+  int StopAndReport(std::uint64_t total_commands);
+  // Status queries of our own after STOP (HostLink sends nothing more):
+  // true once a report says the device is idle or faulted.
+  bool AtRest(std::uint64_t now_us, std::string* state);
+
+  hal::Transport& transport_;
+  TransportLoopOptions options_;
+  HostLink link_;
+  std::vector<std::uint8_t> out_;
+  std::uint64_t reconnects_ = 0;
+  // The rest query after STOP.
+  bool tap_ = false;
+  protocol::FrameDecoderBuffer<protocol::kMaxFrameBytes> tap_decoder_;
+  std::uint16_t rest_token_ = 0xFF00;
+  std::uint64_t rest_query_us_ = 0;
+  std::optional<protocol::StatusReport> rest_report_;
+};
+
+/// Seconds (an option) as whole milliseconds, rounded up.
+std::uint32_t Milliseconds(double seconds);
+
+/// The job as the device can run it: a device that ticks slower than the
+/// job's speed needs (max_rate steps/s over HELLO's tick_hz) gets the speed
+/// limit lowered to its tick rate, with a note on stderr (unless quiet) that
+/// names the device and both speeds. DeviceError when the device drives
+/// fewer axes than the job needs.
+StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello,
+                         const std::string& device, const StreamOptions& o);
+
+}  // namespace fdsurf::host
