@@ -26,6 +26,7 @@ of the logs are printed. Exit 0 pass, 1 fail, 2 bad usage.
 """
 import argparse
 import os
+import select
 import shlex
 import signal
 import subprocess
@@ -66,21 +67,20 @@ class Processes:
     def start(self, name, command, wait_ready_s):
         """Starts `command`, waits for its `ready` line on stdout."""
         err = open(self.log_path(name), "w")
-        process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err, text=True,
+        process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err,
                                    start_new_session=True)
         self.running.append((name, process))
         deadline = time.monotonic() + wait_ready_s
-        os.set_blocking(process.stdout.fileno(), False)
-        seen = ""
+        out = process.stdout.fileno()
+        seen = b""
         while time.monotonic() < deadline:
-            chunk = process.stdout.read() or ""
-            seen += chunk
-            if "ready\n" in seen:
+            if select.select([out], [], [], 0.05)[0]:
+                seen += os.read(out, 4096)
+            if b"ready\n" in seen:
                 return process
             if process.poll() is not None:
                 raise Failure("%s exited with %d before it was ready: %s" %
                               (name, process.returncode, shlex.join(command)))
-            time.sleep(0.05)
         raise Failure("%s was not ready within %.0f s: %s" % (name, wait_ready_s,
                                                              shlex.join(command)))
 
@@ -200,6 +200,11 @@ def run(args, processes):
     stream(args, processes, board, link, duration_s)
     time.sleep(0.5)  # the last pin changes after the last acknowledgement
     processes.stop("relay")
+    expected = {"hangup": "hung up after", "corrupt": "corrupted"}.get(args.scenario)
+    with open(os.path.join(work, "relay.log")) as f:
+        if expected and expected not in f.read():
+            raise Failure("the relay's %s never happened (the job sent fewer than %d bytes?)" %
+                          (args.scenario, args.disturb_after))
     code = processes.stop("harness")
     if code != 0:
         raise Failure("the harness exited with %s after SIGTERM" % code)
