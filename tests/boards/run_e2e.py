@@ -5,7 +5,7 @@
   run_e2e.py --board mega2560-ramps --fdsurf build/fdsurf \\
       --checker build/tests/boards/fdsurf_waveform_check \\
       --relay tests/boards/serial_relay.py --job examples/bezier-bump.json \\
-      [--scenario plain|stop|hangup|corrupt] [--job-args "--fit 40x30 --lines 2"] \\
+      [--scenario plain|stop|hangup|corrupt] [--job-args "--fit 20x15 --speed 20"] \\
       --harness build/boards/mega2560-ramps/host/fdsurf_simavr_board --elf FILE.elf
 
 1. the simulated plotter runs the job at the board's tick rate and writes the
@@ -35,15 +35,18 @@ import tempfile
 import time
 
 # Per board: the tick rate its HELLO reports (the reference runs at it), the
-# baud of its UART and the step timing its drivers need (DRV8825: 1.9 µs
-# pulse, 650 ns DIR set-up; the micro:bit's edge-connector drivers: A4988).
+# baud of its UART, the step timing its drivers need (RAMPS: DRV8825, 1.9 µs
+# pulse and 650 ns DIR set-up; A4988 elsewhere: 1 µs, 200 ns) and the short
+# CI job's options (the speed at most one step per tick; about 6 s of
+# machine time).
 BOARDS = {
-    "mega2560-ramps": {"tick_hz": 20000, "baud": 115200, "min_pulse_ns": 1900,
-                       "min_dir_setup_ns": 650},
-    "microbit-v1": {"tick_hz": 10000, "baud": 115200, "min_pulse_ns": 1000,
-                    "min_dir_setup_ns": 200},
+    "mega2560-ramps": {"tick_hz": 2000, "baud": 115200, "min_pulse_ns": 1900,
+                       "min_dir_setup_ns": 650,
+                       "job_args": "--fit 20x15 --lines 2 --speed 20"},
+    "microbit-v1": {"tick_hz": 20000, "baud": 115200, "min_pulse_ns": 1000,
+                    "min_dir_setup_ns": 200, "job_args": "--fit 40x30 --lines 2"},
     "standin": {"tick_hz": 10000, "baud": 115200, "min_pulse_ns": 1900,
-                "min_dir_setup_ns": 650},
+                "min_dir_setup_ns": 650, "job_args": "--fit 40x30 --lines 2"},
 }
 
 
@@ -230,8 +233,9 @@ def parse():
     parser.add_argument("--relay", default=os.path.join(os.path.dirname(__file__),
                                                         "serial_relay.py"))
     parser.add_argument("--job", required=True, help="a patch file")
-    parser.add_argument("--job-args", default="--fit 40x30 --lines 2",
-                        help="fdsurf stream options of both runs (one string)")
+    parser.add_argument("--job-args",
+                        help="fdsurf stream options of both runs, one string (default: the "
+                             "board's short job)")
     parser.add_argument("--scenario", default="plain",
                         choices=["plain", "stop", "hangup", "corrupt"])
     parser.add_argument("--tick-hz", type=int, help="override the board's tick rate")
@@ -244,6 +248,8 @@ def parse():
     parser.add_argument("--harness", nargs=argparse.REMAINDER, required=True,
                         help="the harness command (last: everything after it is its)")
     args = parser.parse_args()
+    if args.job_args is None:
+        args.job_args = BOARDS[args.board]["job_args"]
     args.job_args = shlex.split(args.job_args)
     if not args.harness:
         parser.error("--harness needs a command")
