@@ -106,10 +106,12 @@ class Device {
   /// everything before it has been executed, then takes effect.
   /// Also finishes what Tick() left to the main loop: a stop that has come
   /// to rest (the buffer dropped, the pen lifted) and the queue drop after a
-  /// fault.
-  void Fill() {
+  /// fault. `max_entries` bounds the entries pushed by this call, so that a
+  /// device whose motion consumes entries faster than it expands them (an
+  /// 8-bit MCU) still gets back to Service() and answers the host.
+  void Fill(uint16_t max_entries = 0xFFFFu) {
     FinishStopAtRest();
-    for (;;) {
+    for (uint16_t pushed = 0; pushed < max_entries;) {
       if (fault_) {
         DropQueue();
         return;
@@ -136,6 +138,7 @@ class Device {
       // RoomToFill() saw room, and Tick() only ever makes more.
       const InterruptLock lock;
       (void)motion_.Push(entry);
+      ++pushed;
     }
   }
 

@@ -1,0 +1,338 @@
+// SPDX-License-Identifier: MIT
+// fdsurf_simavr_board: the Mega 2560 + RAMPS 1.4 image under simavr, as the
+// emulator harness of boards/README (docs/boards.md) describes:
+//
+//   fdsurf_simavr_board --elf IMAGE.elf --uart-socket PATH --waveform OUT
+//                       [--time-limit-s N] [--measures OUT.tsv] [--speed realtime|max]
+//
+// UART0 is bridged to a Unix-domain stream socket at PATH (one client at a
+// time; the next is accepted when it leaves). Received bytes enter simavr's
+// UART at its byte timing under its XON/XOFF input flow control, so none is
+// lost by the emulator. Every change of the RAMPS step/dir/enable pins and
+// of the servo pin (D11 = PB5 = OC1A) goes to OUT with its emulated time in
+// ns (waveform format 1). With --measures: the step interrupt's cycles, late
+// ticks, the main loop's cycles per emitted point, the painted stack's
+// high-water mark, flash and static RAM, as a TSV (host/README.md).
+// Exits 0 on SIGTERM/SIGINT or at the time limit, having flushed OUT.
+#include <avr_ioport.h>
+#include <avr_uart.h>
+#include <poll.h>
+#include <sim_avr.h>
+#include <sim_elf.h>
+#include <sim_interrupts.h>
+#include <sim_io.h>
+#include <sim_irq.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "board_measures.h"
+
+namespace {
+
+constexpr std::uint32_t kCpuHz = 16'000'000;
+// Emulated cycles between two looks at the socket: 125 us, under one byte
+// time at 250 000 bit/s x 3 (simavr's UART takes 64 bytes ahead).
+constexpr std::uint64_t kSliceCycles = 2'000;
+
+volatile std::sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+
+struct Options {
+  std::string elf;
+  std::string socket_path;
+  std::string waveform;
+  std::string measures;
+  double time_limit_s = 0;  // 0: none
+  bool realtime = true;
+};
+
+[[noreturn]] void Usage(const std::string& why) {
+  std::fprintf(stderr,
+               "fdsurf_simavr_board: %s\nusage: fdsurf_simavr_board --elf IMAGE.elf "
+               "--uart-socket PATH --waveform OUT [--time-limit-s N] [--measures OUT.tsv] "
+               "[--speed realtime|max]\n",
+               why.c_str());
+  std::exit(2);
+}
+
+Options ParseOptions(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (i + 1 >= argc) Usage(arg + ": needs a value");
+    const std::string value = argv[++i];
+    if (arg == "--elf") {
+      o.elf = value;
+    } else if (arg == "--uart-socket") {
+      o.socket_path = value;
+    } else if (arg == "--waveform") {
+      o.waveform = value;
+    } else if (arg == "--measures") {
+      o.measures = value;
+    } else if (arg == "--time-limit-s") {
+      char* end = nullptr;
+      o.time_limit_s = std::strtod(value.c_str(), &end);
+      if (end == value.c_str() || *end != 0 || !(o.time_limit_s > 0)) {
+        Usage("--time-limit-s: '" + value + "' is not a positive number of seconds");
+      }
+    } else if (arg == "--speed") {
+      if (value != "realtime" && value != "max") Usage("--speed: realtime or max");
+      o.realtime = value == "realtime";
+    } else {
+      Usage("unknown option " + arg);
+    }
+  }
+  if (o.elf.empty() || o.socket_path.empty() || o.waveform.empty()) {
+    Usage("--elf, --uart-socket and --waveform are required");
+  }
+  return o;
+}
+
+// --- The UART bridge -------------------------------------------------------
+
+class UartBridge {
+ public:
+  bool Listen(const std::string& path, std::string* error);
+  void Attach(avr_t* avr);
+  /// Accepts, reads and writes without waiting; feeds the UART while it
+  /// takes bytes.
+  void Service();
+  /// Waits up to `timeout_ms` for the socket (for pacing to real time).
+  void Wait(int timeout_ms);
+  void Close();
+  std::uint64_t bytes_in() const { return bytes_in_; }
+  std::uint64_t bytes_out() const { return bytes_out_; }
+
+ private:
+  static void OnOutput(avr_irq_t*, std::uint32_t value, void* param);
+  static void OnXon(avr_irq_t*, std::uint32_t, void* param);
+  static void OnXoff(avr_irq_t*, std::uint32_t value, void* param);
+  void Feed();
+  void Drop();
+
+  std::string path_;
+  int listen_fd_ = -1;
+  int client_fd_ = -1;
+  avr_irq_t* input_ = nullptr;
+  bool xoff_ = true;  // until the firmware enables its receiver
+  std::deque<std::uint8_t> to_board_;
+  std::vector<std::uint8_t> to_client_;
+  std::uint64_t bytes_in_ = 0;
+  std::uint64_t bytes_out_ = 0;
+};
+
+bool UartBridge::Listen(const std::string& path, std::string* error) {
+  sockaddr_un address{};
+  if (path.size() >= sizeof address.sun_path) {
+    *error = path + ": too long for a Unix socket path";
+    return false;
+  }
+  address.sun_family = AF_UNIX;
+  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  listen_fd_ = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  (void)unlink(path.c_str());
+  if (listen_fd_ < 0 ||
+      bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+      listen(listen_fd_, 1) != 0) {
+    *error = path + ": " + std::strerror(errno);
+    return false;
+  }
+  path_ = path;
+  return true;
+}
+
+void UartBridge::Attach(avr_t* avr) {
+  std::uint32_t flags = 0;  // no console echo, no sleeping while polled
+  avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
+  input_ = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT), OnOutput,
+                          this);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON), OnXon,
+                          this);
+  avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF), OnXoff,
+                          this);
+}
+
+void UartBridge::OnOutput(avr_irq_t*, std::uint32_t value, void* param) {
+  auto* self = static_cast<UartBridge*>(param);
+  ++self->bytes_out_;
+  if (self->client_fd_ >= 0) self->to_client_.push_back(static_cast<std::uint8_t>(value));
+}
+
+void UartBridge::OnXon(avr_irq_t*, std::uint32_t, void* param) {
+  auto* self = static_cast<UartBridge*>(param);
+  self->xoff_ = false;
+  self->Feed();
+}
+
+void UartBridge::OnXoff(avr_irq_t*, std::uint32_t value, void* param) {
+  static_cast<UartBridge*>(param)->xoff_ = value != 0;
+}
+
+// simavr raises XOFF from inside the input IRQ once its FIFO is full.
+void UartBridge::Feed() {
+  while (!xoff_ && !to_board_.empty()) {
+    const std::uint8_t byte = to_board_.front();
+    to_board_.pop_front();
+    ++bytes_in_;
+    avr_raise_irq(input_, byte);
+  }
+}
+
+void UartBridge::Drop() {
+  close(client_fd_);
+  client_fd_ = -1;
+  to_client_.clear();
+}
+
+void UartBridge::Service() {
+  if (client_fd_ < 0 && listen_fd_ >= 0) {
+    client_fd_ = accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+  }
+  if (client_fd_ >= 0 && to_board_.size() < 4096) {
+    std::uint8_t buffer[1024];
+    const ssize_t n = recv(client_fd_, buffer, sizeof buffer, 0);
+    if (n > 0) {
+      to_board_.insert(to_board_.end(), buffer, buffer + n);
+    } else if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) {
+      Drop();  // the client left: bytes it sent stay on their way to the board
+    }
+  }
+  if (client_fd_ >= 0 && !to_client_.empty()) {
+    const ssize_t n = send(client_fd_, to_client_.data(), to_client_.size(), MSG_NOSIGNAL);
+    if (n > 0) {
+      to_client_.erase(to_client_.begin(), to_client_.begin() + n);
+    } else if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+      Drop();
+    }
+  }
+  Feed();
+}
+
+void UartBridge::Wait(int timeout_ms) {
+  pollfd fd{client_fd_ >= 0 ? client_fd_ : listen_fd_, POLLIN, 0};
+  (void)poll(&fd, 1, timeout_ms);
+}
+
+void UartBridge::Close() {
+  if (client_fd_ >= 0) Drop();
+  if (listen_fd_ >= 0) {
+    close(listen_fd_);
+    (void)unlink(path_.c_str());
+  }
+  listen_fd_ = -1;
+}
+
+// --- Running ---------------------------------------------------------------
+
+struct Emulator {
+  avr_t* avr = nullptr;
+  elf_firmware_t firmware{};
+};
+
+bool LoadImage(const std::string& path, Emulator* emulator) {
+  if (elf_read_firmware(path.c_str(), &emulator->firmware) != 0) {
+    std::fprintf(stderr, "fdsurf_simavr_board: %s: cannot read the ELF image\n", path.c_str());
+    return false;
+  }
+  emulator->avr = avr_make_mcu_by_name("atmega2560");
+  if (emulator->avr == nullptr) return false;
+  avr_init(emulator->avr);
+  emulator->avr->log = LOG_ERROR;
+  emulator->firmware.frequency = kCpuHz;
+  avr_load_firmware(emulator->avr, &emulator->firmware);
+  emulator->avr->frequency = kCpuHz;
+  return true;
+}
+
+std::uint64_t NowNs() {
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now().time_since_epoch())
+                                        .count());
+}
+
+// Runs until a signal, the time limit or a crash; true unless it crashed.
+bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge) {
+  avr_t* avr = emulator->avr;
+  const std::uint64_t limit =
+      o.time_limit_s > 0 ? static_cast<std::uint64_t>(o.time_limit_s * kCpuHz) : UINT64_MAX;
+  const std::uint64_t wall_start = NowNs();
+  while (g_stop == 0 && avr->cycle < limit) {
+    const std::uint64_t slice_end = avr->cycle + kSliceCycles;
+    while (avr->cycle < slice_end) {
+      const int state = avr_run(avr);
+      if (state == cpu_Done || state == cpu_Crashed) {
+        std::fprintf(stderr, "fdsurf_simavr_board: the core stopped (%s) at cycle %llu\n",
+                     state == cpu_Crashed ? "crashed" : "done",
+                     static_cast<unsigned long long>(avr->cycle));
+        return false;
+      }
+    }
+    bridge->Service();
+    if (o.realtime) {
+      // Never ahead of the wall clock: the host's timeouts are wall time.
+      const std::uint64_t emulated_ns = avr->cycle * 125 / 2;
+      const std::uint64_t wall_ns = NowNs() - wall_start;
+      if (emulated_ns > wall_ns + 1'000'000) {
+        bridge->Wait(static_cast<int>((emulated_ns - wall_ns) / 1'000'000));
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = ParseOptions(argc, argv);
+  // libsimavr prints its progress on stdout, which is for "ready" only.
+  std::fflush(stdout);
+  FILE* out = fdopen(dup(STDOUT_FILENO), "w");
+  if (out == nullptr || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) return 2;
+  Emulator emulator;
+  if (!LoadImage(o.elf, &emulator)) return 2;
+  fdsurf::board::Recorder recorder;
+  std::string error;
+  if (!recorder.Open(o.waveform, &error)) {
+    std::fprintf(stderr, "fdsurf_simavr_board: %s\n", error.c_str());
+    return 2;
+  }
+  recorder.Attach(emulator.avr);
+  UartBridge bridge;
+  bridge.Attach(emulator.avr);
+  if (!bridge.Listen(o.socket_path, &error)) {
+    std::fprintf(stderr, "fdsurf_simavr_board: --uart-socket %s\n", error.c_str());
+    return 2;
+  }
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGPIPE, SIG_IGN);
+  std::fputs("ready\n", out);
+  std::fflush(out);
+  const bool ok = RunLoop(o, &emulator, &bridge);
+  bridge.Close();
+  recorder.Finish(emulator.avr);
+  if (!o.measures.empty()) {
+    fdsurf::board::ImageFacts facts{emulator.firmware.flashsize, emulator.firmware.datasize,
+                                    emulator.firmware.bsssize};
+    if (!recorder.WriteMeasures(o.measures, emulator.avr, facts, bridge.bytes_in(),
+                                bridge.bytes_out(), &error)) {
+      std::fprintf(stderr, "fdsurf_simavr_board: --measures %s\n", error.c_str());
+      return 2;
+    }
+  }
+  std::fclose(out);
+  return ok ? 0 : 1;
+}
