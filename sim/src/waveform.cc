@@ -81,6 +81,7 @@ void ParseHeaderLine(const std::string& line, WaveformHeader* header, const std:
     header->enable_active_level = HeaderLevel(value, key, where);
   } else if (key == "pen") {
     ParsePen(value, header, where);
+    header->pen_declared = true;
   } else {
     header->extra[key] = value;
   }

@@ -284,7 +284,11 @@ void Decoder::PenLevel(const Transition& t) {
 // A servo pulse's width says where the servo goes: nearer the down width is
 // down. The change takes effect at the pulse's rising edge.
 void Decoder::ServoEdge(const Transition& t) {
-  if (header_.pen != PenKind::kServo) return;
+  if (header_.pen != PenKind::kServo) {
+    throw WaveformError("waveform of board '" + header_.board + "': SERVO pulses at " +
+                        std::to_string(t.time_ns) +
+                        " ns, but the header has no '# pen servo UP_US DOWN_US' line");
+  }
   if (t.level == 1) {
     if (servo_rise_ns_ >= 0) {
       const std::int64_t period = t.time_ns - servo_rise_ns_;

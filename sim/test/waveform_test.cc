@@ -278,6 +278,13 @@ TEST(WaveformDecode, AServoPenIsReadFromThePulseWidths) {
   EXPECT_EQ(d.timing.servo_period_ns, 20'000'000);
 }
 
+TEST(WaveformDecode, ServoPulsesWithoutAServoHeaderAreAnError) {
+  std::stringstream text;
+  text << "# fdsurf-waveform 1\n# board test\n0 SERVO 1\n1000000 SERVO 0\n";
+  const Waveform w = ReadWaveform(text, "servo");
+  EXPECT_THROW((void)DecodeWaveform(w), WaveformError);
+}
+
 void ExpectError(const std::string& text, const std::string& message) {
   std::stringstream in(text);
   try {

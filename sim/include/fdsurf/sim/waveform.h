@@ -76,6 +76,8 @@ struct WaveformHeader {
   int pen_down_level = 1;
   std::uint32_t servo_up_us = 1000;
   std::uint32_t servo_down_us = 2000;
+  /// Whether a `# pen` line said what the pen is.
+  bool pen_declared = false;
   /// Other `# key value` lines, in order of the keys.
   std::map<std::string, std::string> extra;
 
@@ -190,6 +192,8 @@ struct DecodedWaveform {
 };
 
 /// Decodes the pins into unit moves and pen changes, with the timing report.
+/// Throws WaveformError if SERVO pulses appear but the header does not
+/// declare a servo pen (its widths are needed to read them).
 DecodedWaveform DecodeWaveform(const Waveform& waveform, const DecodeOptions& options = {});
 
 }  // namespace fdsurf::sim
