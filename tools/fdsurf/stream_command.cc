@@ -127,6 +127,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->capture_default_str();
   command->add_option("--svg", o->svg, "sim: write what the plotter drew as SVG");
   command->add_option("--png", o->png, "sim: draw what the plotter drew as a PNG picture");
+  command->add_option("--waveform", o->waveform,
+                      "sim: write the plotter's step/dir/enable/pen pins (docs/boards.md)");
   command->add_option("--size", o->png_width, "PNG width in pixels")
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
@@ -143,8 +145,9 @@ int RunStream(const StreamOptions& o) {
                      "' is not sim, usb[:VID:PID|:BUS-PORT], serial:PATH[:BAUD], serial:auto or "
                      "gpio:CHIP:LINES");
   }
-  if (!sim && (!o.svg.empty() || !o.png.empty() || o.faults > 0 || o.sim_cost != "none")) {
-    throw InputError("--svg, --png, --faults and --sim-cost are for --device sim");
+  if (!sim && (!o.svg.empty() || !o.png.empty() || !o.waveform.empty() || o.faults > 0 ||
+               o.sim_cost != "none")) {
+    throw InputError("--svg, --png, --waveform, --faults and --sim-cost are for --device sim");
   }
   if (sim && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000");

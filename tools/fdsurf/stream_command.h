@@ -43,6 +43,8 @@ struct StreamOptions {
   std::uint64_t seed = 1;
   std::string svg;
   std::string png;
+  /// sim: the plotter's step/dir/enable/pen pins in the waveform format.
+  std::string waveform;
   int png_width = 1600;
   bool quiet = false;
 };

@@ -65,9 +65,10 @@ bool Recorder::Open(const std::string& path, std::string* error) {
     return false;
   }
   path_ = path;
+  // The pen: the image's default servo pulses (board_config.h).
   std::fputs(
       "# fdsurf-waveform 1\n# board mega2560-ramps\n# dir_negative_level 1\n"
-      "# enable_active_level 0\n",
+      "# enable_active_level 0\n# pen servo 1000 2000\n",
       file_);
   return true;
 }

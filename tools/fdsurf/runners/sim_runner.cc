@@ -3,6 +3,7 @@
 // the drawing is compared with the exact curves and the recorded steps with
 // the machine's limits.
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "fdsurf/protocol/codec.h"
 #include "fdsurf/sim/checks.h"
 #include "fdsurf/sim/plotter.h"
+#include "fdsurf/sim/waveform.h"
 #include "runner.h"
 
 namespace fdsurf::host {
@@ -125,12 +127,36 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   return checked;
 }
 
-// SVG and PNG of what was drawn: every one complete before any is renamed
-// into place.
+// The plotter's pins as a waveform (docs/boards.md), with the job's limits
+// in the header for the checker: a PEN line, DIR high towards negative,
+// ENABLE active low (as A4988/DRV8825 boards).
+void WriteWaveformFile(const std::string& path, const std::string& name, const StreamJob& job,
+                       const sim::SimulatedPlotter& plotter) {
+  sim::WaveformHeader header;
+  header.board = "sim";
+  header.extra["axes"] = std::to_string(plotter.options().axes);
+  header.extra["tick_hz"] = std::to_string(plotter.options().tick_hz);
+  header.extra["max_rate"] = std::to_string(job.config.max_rate);
+  header.extra["accel"] = std::to_string(job.config.accel);
+  header.extra["pen_delay_ms"] = std::to_string(job.config.pen_delay_ms);
+  header.extra["commands"] = std::to_string(job.commands.size());
+  sim::WaveformWriteOptions write;
+  write.axes = plotter.options().axes;
+  std::ofstream out(path, std::ios::binary);
+  sim::WriteWaveform(
+      out, header,
+      sim::TransitionsFromEvents(header, plotter.step_events(), plotter.pen_events(), write));
+  out.close();
+  if (!out) throw OutputError(name + ": cannot write the waveform");
+}
+
+// SVG, PNG and waveform of what was drawn: every one complete before any is
+// renamed into place.
 void WriteDrawing(const StreamOptions& o, const StreamJob& job,
-                  const std::vector<sim::DrawnPath>& drawn) {
+                  const sim::SimulatedPlotter& plotter, const std::vector<sim::DrawnPath>& drawn) {
   const Toolpath drawn_path = DrawnToolpath(job, drawn);
   StagedOutputs outputs;
+  if (!o.waveform.empty()) WriteWaveformFile(outputs.Stage(o.waveform), o.waveform, job, plotter);
   if (!o.svg.empty()) {
     WriteFile(outputs.Stage(o.svg),
               WriteSvg(drawn_path, o.file + " drawn by the simulated plotter"));
@@ -190,6 +216,7 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   std::fprintf(stderr, "motion limits (%.0f %s/s, %.0f %s/s², pen delay %d ms): %s\n", o.speed,
                units.c_str(), o.accel, units.c_str(), o.pen_delay_ms, limits.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
+  if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
   if (!o.png.empty()) {
     std::fprintf(stderr, "wrote %s (png, %d px wide)\n", o.png.c_str(), o.png_width);
   }
@@ -205,7 +232,7 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   const sim::RunResult run = StreamToPlotter(o, job, &plotter);
   if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
   const CheckedDrawing checked = CheckDrawing(plotter, set, job, plotter_options.tick_hz, o.dims);
-  WriteDrawing(o, job, checked.drawn);
+  WriteDrawing(o, job, plotter, checked.drawn);
   if (!o.quiet) PrintReport(o, set, job, drawing, units, plotter_options, run, checked);
   return checked.within && checked.limits_kept ? 0 : 1;
 }
