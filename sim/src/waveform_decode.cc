@@ -24,9 +24,34 @@ bool IsEdgeSignal(int s) { return s == Index(WaveSignal::kServo) || (s < 9 && s 
 
 // Converts pin times (ns) to the simulator's µs, snapped to the board's tick
 // grid when its rate is known (phase: the first STEP edge).
+//
+// A board writes its pins at different points of its tick interrupt (a pen
+// change early, a step after the motion's arithmetic) and the interrupt
+// itself may start late, so the nearest grid tick of an edge can be a tick
+// off. A device does at most one unit move or one pen change per tick, so
+// each of those gets a tick after the previous one's (OwnTickMicros); DIR
+// and EN changes happen in the tick of the step they prepare and never
+// before the last move or pen change (StateMicros). The order of the
+// recording is kept; only times move, by less than a tick.
 class TimeBase {
  public:
   TimeBase(std::uint32_t tick_hz, std::int64_t phase_ns) : tick_hz_(tick_hz), phase_ns_(phase_ns) {}
+
+  std::uint64_t OwnTickMicros(std::int64_t ns) {
+    std::uint64_t us = Micros(ns);
+    if (tick_hz_ != 0 && has_own_ && us < last_own_us_ + TickMicros()) {
+      us = last_own_us_ + TickMicros();
+    }
+    last_own_us_ = us;
+    has_own_ = true;
+    return us;
+  }
+  std::uint64_t StateMicros(std::int64_t ns) const {
+    const std::uint64_t us = Micros(ns);
+    return tick_hz_ != 0 && has_own_ && us < last_own_us_ ? last_own_us_ : us;
+  }
+
+ private:
   std::uint64_t Micros(std::int64_t ns) const {
     if (tick_hz_ == 0) return static_cast<std::uint64_t>(ns / 1000);
     const double tick_ns = 1e9 / tick_hz_;
@@ -34,10 +59,12 @@ class TimeBase {
     const double grid_ns = static_cast<double>(phase_ns_) + k * tick_ns;
     return grid_ns <= 0 ? 0 : static_cast<std::uint64_t>(std::floor(grid_ns * 1e-3 + 1e-6));
   }
+  std::uint64_t TickMicros() const { return 1'000'000 / tick_hz_; }
 
- private:
   std::uint32_t tick_hz_;
   std::int64_t phase_ns_;
+  std::uint64_t last_own_us_ = 0;
+  bool has_own_ = false;
 };
 
 class Decoder {
@@ -75,10 +102,14 @@ class Decoder {
   }
   bool Enabled() const;
   void Problem(const std::string& what);
+  // A unit move or pen change at `time_ns`: the interval since the last one.
+  void OwnTick(std::int64_t time_ns);
 
   const WaveformHeader& header_;
   DecodeOptions options_;
   TimeBase time_;
+  std::int64_t last_own_ns_ = -1;
+  std::uint32_t tick_hz_;
   std::int64_t window_ns_;
   std::array<bool, 11> seen_{};
   std::array<int, 11> level_{};
@@ -114,8 +145,9 @@ Decoder::Decoder(const WaveformHeader& header, const DecodeOptions& options,
     : header_(header),
       options_(options),
       time_(TickHz(header, options), FirstStepRise(transitions)),
-      window_ns_(options.group_window_ns) {
-  const std::uint32_t tick_hz = TickHz(header, options);
+      window_ns_(options.group_window_ns),
+      tick_hz_(TickHz(header, options)) {
+  const std::uint32_t tick_hz = tick_hz_;
   if (window_ns_ <= 0) window_ns_ = tick_hz != 0 ? 500'000'000 / tick_hz : kDefaultGroupWindowNs;
   for (const Transition& t : transitions) {
     if (IsEdgeSignal(Index(t.signal)) && t.signal != WaveSignal::kServo && t.level == 1) {
@@ -130,6 +162,22 @@ bool Decoder::Enabled() const {
     if ((stepping_axes_ >> axis & 1) != 0 && !AxisEnabled(axis)) return false;
   }
   return true;
+}
+
+void Decoder::OwnTick(std::int64_t time_ns) {
+  if (last_own_ns_ >= 0) {
+    const std::int64_t interval = time_ns - last_own_ns_;
+    WaveformTiming& t = out_.timing;
+    if (t.min_event_interval_ns < 0 || interval < t.min_event_interval_ns) {
+      t.min_event_interval_ns = interval;
+    }
+    if (tick_hz_ != 0 && interval * 2 * tick_hz_ < 1'000'000'000) {
+      ++t.crowded_ticks;
+      Problem("at " + std::to_string(time_ns) + " ns: a move or pen change only " +
+              std::to_string(interval) + " ns after the previous one (under half a tick)");
+    }
+  }
+  last_own_ns_ = time_ns;
 }
 
 void Decoder::Problem(const std::string& what) {
@@ -236,7 +284,7 @@ void Decoder::EnableChange(const Transition& t) {
 // A DIR or EN change as an axis_mask 0 event. DIR changes at the same time
 // are one event (one SetDirections()).
 void Decoder::StateEvent(std::int64_t time_ns, bool dir_change) {
-  const std::uint64_t us = time_.Micros(time_ns);
+  const std::uint64_t us = time_.StateMicros(time_ns);
   if (pending_state_ && dir_change && pending_is_dir_ && pending_state_->time_us == us) {
     pending_state_->negative_mask = negative_;
     return;
@@ -261,9 +309,14 @@ void Decoder::CloseGroup() {
   const Group g = *group_;
   group_.reset();
   out_.moves.push_back(UnitMove{g.time_ns, g.axis_mask, g.negative_mask});
-  out_.step_events.push_back(
-      hal::StepDirEvent{time_.Micros(g.time_ns), g.axis_mask, g.negative_mask, g.enabled});
-  for (const hal::StepDirEvent& e : held_) out_.step_events.push_back(e);
+  OwnTick(g.time_ns);
+  const std::uint64_t us = time_.OwnTickMicros(g.time_ns);
+  out_.step_events.push_back(hal::StepDirEvent{us, g.axis_mask, g.negative_mask, g.enabled});
+  // Changes held while the group was open came after its first edge.
+  for (hal::StepDirEvent e : held_) {
+    e.time_us = std::max(e.time_us, us);
+    out_.step_events.push_back(e);
+  }
   held_.clear();
 }
 
@@ -273,7 +326,8 @@ void Decoder::PenTo(bool down, std::int64_t time_ns) {
   FlushState();
   pen_down_ = down;
   out_.pens.push_back(PenChange{time_ns, down, out_.moves.size()});
-  out_.pen_events.push_back(hal::PenEvent{time_.Micros(time_ns), down});
+  OwnTick(time_ns);
+  out_.pen_events.push_back(hal::PenEvent{time_.OwnTickMicros(time_ns), down});
 }
 
 void Decoder::PenLevel(const Transition& t) {

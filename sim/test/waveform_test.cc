@@ -255,7 +255,34 @@ TEST(WaveformDecode, GroupsAxesWithinTheWindowIntoOneMove) {
   EXPECT_EQ(d.moves[1].axis_mask, 1);  // X twice: two moves
   EXPECT_EQ(d.moves[2].axis_mask, 1);
   EXPECT_EQ(d.moves[3].axis_mask, 2);
-  EXPECT_EQ(d.step_events[3].time_us, 50u);
+  // X twice 3 µs apart cannot be one tick each: counted, and the second is
+  // given the next tick (the times keep one move per tick, in order).
+  EXPECT_EQ(d.timing.crowded_ticks, 1u);
+  EXPECT_EQ(d.timing.min_event_interval_ns, 3000);
+  EXPECT_EQ(d.step_events[2].time_us, 50u);
+  EXPECT_EQ(d.step_events[3].time_us, 75u);
+}
+
+// A board writes a pen change early in its tick interrupt and a step late,
+// so a pen change can come less than a tick after the step before it (here
+// 0.8 tick, as the micro:bit does); its nearest grid tick is then the
+// step's. It still gets a tick of its own, after the step, so the replay
+// keeps the pen change after the step and the motion check sees no step
+// at the pen change.
+TEST(WaveformDecode, APenChangeEarlyInItsTickStaysAfterTheStepBeforeIt) {
+  Waveform w;
+  w.header.extra["tick_hz"] = "20000";  // 50 µs
+  w.header.pen = PenKind::kLine;
+  w.header.pen_down_level = 1;
+  w.transitions = {{0, WaveSignal::kPen, 0},          {40000, WaveSignal::kXStep, 1},
+                   {42000, WaveSignal::kXStep, 0},    {90000, WaveSignal::kXStep, 1},
+                   {92000, WaveSignal::kXStep, 0},    {130000, WaveSignal::kPen, 1}};
+  const DecodedWaveform d = DecodeWaveform(w);
+  ASSERT_EQ(d.moves.size(), 2u);
+  ASSERT_EQ(d.pen_events.size(), 1u);
+  EXPECT_GT(d.pen_events[0].time_us, d.step_events.back().time_us);
+  EXPECT_EQ(d.timing.crowded_ticks, 0u);
+  EXPECT_EQ(d.timing.min_event_interval_ns, 40000);
 }
 
 TEST(WaveformDecode, AServoPenIsReadFromThePulseWidths) {

@@ -176,10 +176,11 @@ MotionReport CheckRecordedMotion(const DecodedWaveform& rec, MotionLimitsSi limi
 void PrintTiming(const WaveformTiming& t, const Options& o) {
   std::printf(
       "timing: shortest STEP pulse %lld ns (at least %lld), shortest DIR set-up %lld ns (at least "
-      "%lld), %zu steps while disabled\n",
+      "%lld), %zu steps while disabled, shortest time between two moves or pen changes %lld ns "
+      "(%zu under half a tick)\n",
       static_cast<long long>(t.min_pulse_ns), static_cast<long long>(o.min_pulse_ns),
       static_cast<long long>(t.min_dir_setup_ns), static_cast<long long>(o.min_dir_setup_ns),
-      t.steps_while_disabled);
+      t.steps_while_disabled, static_cast<long long>(t.min_event_interval_ns), t.crowded_ticks);
 }
 
 int Check(const Options& o) {

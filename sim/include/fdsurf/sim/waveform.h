@@ -172,12 +172,21 @@ struct WaveformTiming {
   std::size_t short_pulses = 0;        ///< below DecodeOptions::min_pulse_ns
   std::size_t short_dir_setups = 0;    ///< below DecodeOptions::min_dir_setup_ns
   std::size_t steps_while_disabled = 0;
+  /// The shortest time between two consecutive unit moves or pen changes
+  /// (-1: fewer than two). A device makes at most one of them per tick, so
+  /// with the tick rate known, an interval under half a tick is counted in
+  /// crowded_ticks: two moves in one tick (a late interrupt followed by an
+  /// on-time one stays above half a tick on the boards).
+  std::int64_t min_event_interval_ns = -1;
+  std::size_t crowded_ticks = 0;
   /// Servo pen: the longest interval between pulses (the PWM period).
   std::int64_t servo_period_ns = 0;
   std::int64_t duration_ns = 0;  ///< time of the last transition
   /// The first of the problems counted above, with its time ("" if none).
   std::string first_problem;
-  std::size_t problems() const { return short_pulses + short_dir_setups + steps_while_disabled; }
+  std::size_t problems() const {
+    return short_pulses + short_dir_setups + steps_while_disabled + crowded_ticks;
+  }
 };
 
 struct DecodedWaveform {
