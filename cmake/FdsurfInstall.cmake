@@ -37,12 +37,13 @@ if(TARGET fdsurf_host)
     install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
             COMPONENT dev)
   endforeach()
-  # The backends that need libusb-1.0 and libgpiod: their own export set, so
-  # find_package(fdsurf) offers them only where those libraries are found.
+  # The backends that need libusb-1.0, libgpiod and libserialport: their own
+  # export set, so find_package(fdsurf) offers them only where those
+  # libraries are found.
   set(FDSURF_PACKAGE_DEVICE ON)
-  install(TARGETS fdsurf_hal_usb fdsurf_hal_gpiod EXPORT fdsurfDeviceTargets
+  install(TARGETS fdsurf_hal_usb fdsurf_hal_gpiod fdsurf_hal_serial EXPORT fdsurfDeviceTargets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
-  foreach(dir hal/libusb hal/libgpiod)
+  foreach(dir hal/libusb hal/libgpiod hal/libserialport)
     install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
             COMPONENT dev)
   endforeach()
