@@ -274,9 +274,9 @@ TEST(WaveformDecode, APenChangeEarlyInItsTickStaysAfterTheStepBeforeIt) {
   w.header.extra["tick_hz"] = "20000";  // 50 µs
   w.header.pen = PenKind::kLine;
   w.header.pen_down_level = 1;
-  w.transitions = {{0, WaveSignal::kPen, 0},          {40000, WaveSignal::kXStep, 1},
-                   {42000, WaveSignal::kXStep, 0},    {90000, WaveSignal::kXStep, 1},
-                   {92000, WaveSignal::kXStep, 0},    {130000, WaveSignal::kPen, 1}};
+  w.transitions = {{0, WaveSignal::kPen, 0},       {40000, WaveSignal::kXStep, 1},
+                   {42000, WaveSignal::kXStep, 0}, {90000, WaveSignal::kXStep, 1},
+                   {92000, WaveSignal::kXStep, 0}, {130000, WaveSignal::kPen, 1}};
   const DecodedWaveform d = DecodeWaveform(w);
   ASSERT_EQ(d.moves.size(), 2u);
   ASSERT_EQ(d.pen_events.size(), 1u);

@@ -92,9 +92,7 @@ class MotionLoop {
   bool Push(uint8_t entry);
   /// No room for an entry of any kind: the buffer is full, or it holds
   /// kMaxPenEvents pen events.
-  FDSURF_NODISCARD bool Full() const {
-    return count_ == capacity_ || stops_ == kMaxPenEvents;
-  }
+  FDSURF_NODISCARD bool Full() const { return count_ == capacity_ || stops_ == kMaxPenEvents; }
   FDSURF_NODISCARD bool Empty() const { return count_ == 0; }
   FDSURF_NODISCARD uint16_t Count() const { return count_; }
   /// At rest, not waiting for the pen, nothing buffered.
