@@ -42,10 +42,10 @@ bash scripts/fuzz.sh 45
 echo "== clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
 
-echo "== clang-tidy (firmware/, hal/, host/, sim/, tools/, the test image's host build)"
+echo "== clang-tidy (firmware/, hal/, host/, sim/, tools/, the boards' emulator harnesses, the test image's host build)"
 # clang-tidy counts the (filtered-out) warnings of system headers on stderr;
 # show its output only when it fails.
-if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tools/*.cc' 'targets/image/*.cc' \
+if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tools/*.cc' 'targets/image/*.cc' 'boards/*/host/*.cc' \
   'targets/port/host.cc' |
   grep -v '/test/' | xargs -P "$jobs" -n 2 clang-tidy -p build --quiet 2>&1); then
   echo "$tidy" | grep -v 'warnings generated'

@@ -123,7 +123,7 @@ std::string ConfigureWithLibserialport(struct sp_port* port, uint32_t baud, IoSt
     return text;
   };
   if (sp_set_baudrate(port, static_cast<int>(baud)) != SP_OK) {
-    const std::string text = failed("the baud");
+    std::string text = failed("the baud");
     *status = IoStatus::kInvalidArgument;
     return text;
   }

@@ -46,20 +46,20 @@ class TimeBase {
     has_own_ = true;
     return us;
   }
-  std::uint64_t StateMicros(std::int64_t ns) const {
+  FDSURF_NODISCARD std::uint64_t StateMicros(std::int64_t ns) const {
     const std::uint64_t us = Micros(ns);
     return tick_hz_ != 0 && has_own_ && us < last_own_us_ ? last_own_us_ : us;
   }
 
  private:
-  std::uint64_t Micros(std::int64_t ns) const {
+  FDSURF_NODISCARD std::uint64_t Micros(std::int64_t ns) const {
     if (tick_hz_ == 0) return static_cast<std::uint64_t>(ns / 1000);
     const double tick_ns = 1e9 / tick_hz_;
     const double k = std::round(static_cast<double>(ns - phase_ns_) / tick_ns);
     const double grid_ns = static_cast<double>(phase_ns_) + k * tick_ns;
     return grid_ns <= 0 ? 0 : static_cast<std::uint64_t>(std::floor(grid_ns * 1e-3 + 1e-6));
   }
-  std::uint64_t TickMicros() const { return 1'000'000 / tick_hz_; }
+  FDSURF_NODISCARD std::uint64_t TickMicros() const { return 1'000'000 / tick_hz_; }
 
   std::uint32_t tick_hz_;
   std::int64_t phase_ns_;
@@ -96,11 +96,11 @@ class Decoder {
   void CloseGroup();
   void StateEvent(std::int64_t time_ns, bool dir_change);
   void FlushState();
-  bool AxisEnabled(int axis) const {
+  FDSURF_NODISCARD bool AxisEnabled(int axis) const {
     return !seen_[Index(EnableSignal(axis))] ||
            level_[Index(EnableSignal(axis))] == header_.enable_active_level;
   }
-  bool Enabled() const;
+  FDSURF_NODISCARD bool Enabled() const;
   void Problem(const std::string& what);
   // A unit move or pen change at `time_ns`: the interval since the last one.
   void OwnTick(std::int64_t time_ns);
@@ -185,8 +185,7 @@ void Decoder::Problem(const std::string& what) {
 }
 
 DecodedWaveform Decoder::Run(const std::vector<Transition>& transitions) {
-  for (std::size_t i = 0; i < transitions.size(); ++i) {
-    const Transition& t = transitions[i];
+  for (const Transition& t : transitions) {
     const int s = Index(t.signal);
     if (!seen_[s] && !IsEdgeSignal(s)) {
       // The first line of a level signal is its initial level.

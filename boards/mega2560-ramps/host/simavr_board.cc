@@ -112,8 +112,8 @@ class UartBridge {
   /// Waits up to `timeout_ms` for the socket (for pacing to real time).
   void Wait(int timeout_ms);
   void Close();
-  std::uint64_t bytes_in() const { return bytes_in_; }
-  std::uint64_t bytes_out() const { return bytes_out_; }
+  [[nodiscard]] std::uint64_t bytes_in() const { return bytes_in_; }
+  [[nodiscard]] std::uint64_t bytes_out() const { return bytes_out_; }
 
  private:
   static void OnOutput(avr_irq_t*, std::uint32_t value, void* param);

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/sim.h"
 
 namespace fdsurf::sim {
@@ -83,7 +84,7 @@ struct WaveformHeader {
 
   /// extra[key] as a number; `fallback` if absent. WaveformError naming the
   /// key if it is not a number.
-  double Number(const std::string& key, double fallback) const;
+  FDSURF_NODISCARD double Number(const std::string& key, double fallback) const;
 };
 
 /// One line of data: `signal` took `level` at `time_ns`.
@@ -184,7 +185,7 @@ struct WaveformTiming {
   std::int64_t duration_ns = 0;  ///< time of the last transition
   /// The first of the problems counted above, with its time ("" if none).
   std::string first_problem;
-  std::size_t problems() const {
+  FDSURF_NODISCARD std::size_t problems() const {
     return short_pulses + short_dir_setups + steps_while_disabled + crowded_ticks;
   }
 };
