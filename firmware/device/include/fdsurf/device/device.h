@@ -304,11 +304,14 @@ class Device {
   // A configuration takes effect once everything before it has been
   // executed; false while the motion is not at rest yet.
   bool ApplyConfigAtRest(const protocol::MachineConfig& config) {
+    // The conversion divides 64-bit numbers (a thousand cycles on a
+    // Cortex-M0, more on an AVR): done before the tick is masked. Accept()
+    // checked that it succeeds.
+    motion::TickLimits tick;
+    const bool converted = motion::ToTickLimits(LimitsOf(config), &tick);
     const InterruptLock lock;
     if (!motion_.Idle()) return false;
-    motion::TickLimits tick;
-    // Accept() checked the same conversion.
-    if (motion::ToTickLimits(LimitsOf(config), &tick)) motion_.Configure(tick);
+    if (converted) motion_.Configure(tick);
     ++executed_;
     return true;
   }
