@@ -318,16 +318,20 @@ IoStatus SerialTransport::DoRead(uint8_t* data, size_t capacity, size_t* receive
   }
 }
 
-std::string SerialTransport::FindAgain() const {
-  if (identity_.transport != "usb" || identity_.usb_serial.empty()) return path_;
-  for (const SerialPortInfo& port : ListSerialPorts()) {
-    if (port.usb_vendor_id == identity_.usb_vendor_id &&
-        port.usb_product_id == identity_.usb_product_id &&
-        port.usb_serial == identity_.usb_serial) {
+std::string FindSamePort(const std::vector<SerialPortInfo>& ports, const SerialPortInfo& identity) {
+  if (identity.transport != "usb" || identity.usb_serial.empty()) return identity.path;
+  for (const SerialPortInfo& port : ports) {
+    if (port.usb_vendor_id == identity.usb_vendor_id &&
+        port.usb_product_id == identity.usb_product_id && port.usb_serial == identity.usb_serial) {
       return port.path;
     }
   }
   return "";
+}
+
+std::string SerialTransport::FindAgain() const {
+  if (identity_.transport != "usb" || identity_.usb_serial.empty()) return path_;
+  return FindSamePort(ListSerialPorts(), identity_);
 }
 
 IoStatus SerialTransport::DoReconnect(uint32_t timeout_ms) {

@@ -292,5 +292,37 @@ TEST(SerialPorts, LibserialportOpensThePortsItLists) {
   GTEST_SKIP() << "no listed serial port can be opened here";
 }
 
+// The reconnect's rule for a USB port: the same VID:PID and serial number,
+// wherever it comes back; a port without a USB serial is its path again.
+TEST(SerialPorts, AUsbBoardIsFoundAgainByItsSerialNumberUnderAnotherPath) {
+  SerialPortInfo mega;
+  mega.path = "/dev/ttyACM0";
+  mega.transport = "usb";
+  mega.usb_vendor_id = 0x2341;
+  mega.usb_product_id = 0x0042;
+  mega.usb_serial = "85736323838351F0E1A1";
+  SerialPortInfo back = mega;
+  back.path = "/dev/ttyACM1";  // re-enumerated under another node
+  SerialPortInfo other_mega = mega;
+  other_mega.path = "/dev/ttyACM0";  // another board of the same kind took the old node
+  other_mega.usb_serial = "7543830343635140B1C0";
+  SerialPortInfo same_serial_other_vid = back;
+  same_serial_other_vid.path = "/dev/ttyUSB0";
+  same_serial_other_vid.usb_vendor_id = 0x0403;
+
+  EXPECT_EQ(FindSamePort({other_mega, back}, mega), "/dev/ttyACM1");
+  EXPECT_EQ(FindSamePort({other_mega, same_serial_other_vid}, mega), "") << "not back yet";
+  EXPECT_EQ(FindSamePort({}, mega), "");
+
+  SerialPortInfo pty;
+  pty.path = "/tmp/board/ttyBOARD";
+  pty.transport = "pty";
+  EXPECT_EQ(FindSamePort({other_mega}, pty), "/tmp/board/ttyBOARD");
+  SerialPortInfo usb_without_serial = mega;
+  usb_without_serial.usb_serial.clear();
+  usb_without_serial.path = "/dev/serial/by-id/usb-1a86_USB2.0-Serial-if00-port0";
+  EXPECT_EQ(FindSamePort({back}, usb_without_serial), usb_without_serial.path);
+}
+
 }  // namespace
 }  // namespace fdsurf::hal

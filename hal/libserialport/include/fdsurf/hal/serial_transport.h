@@ -73,6 +73,14 @@ std::vector<SerialPortInfo> ListSerialPorts();
 /// pseudo-terminal, "unknown" otherwise. `path` stays as given.
 SerialPortInfo DescribeSerialPort(const std::string& path);
 
+/// Where the device `identity` (as it was when first opened) is now, for a
+/// reconnect: for a USB port with a serial number, the path of the port in
+/// `ports` with the same VID:PID and serial number (a board may come back as
+/// another /dev/ttyACMn), "" if none is there yet; for any other port, its
+/// own path again (a /dev/serial/by-id link, or a symlink re-pointed at a
+/// new pty).
+std::string FindSamePort(const std::vector<SerialPortInfo>& ports, const SerialPortInfo& identity);
+
 struct SerialOptions {
   uint32_t baud = 115200;
   /// How often Reconnect() looks for the port again while it waits.
