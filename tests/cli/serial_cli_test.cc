@@ -274,6 +274,12 @@ TEST_F(SerialCli, PortsProbeShowsWhatAnswered) {
   EXPECT_NE(row.find(" pty "), std::string::npos) << row;
   EXPECT_NE(row.find("fdsurf protocol 2, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
       << row;
+  // The machine's own ports (if any are listed) are shown, not opened.
+  std::istringstream rows(r.out);
+  for (std::string other; std::getline(rows, other);) {
+    if (other.rfind("PORT", 0) == 0 || other.find(link_) != std::string::npos) continue;
+    EXPECT_NE(other.find("(not probed)"), std::string::npos) << other;
+  }
 }
 
 TEST_F(SerialCli, PortsProbeOfASilentPortSaysSoAndExits3) {
