@@ -78,6 +78,8 @@ class SerialCli : public ::testing::Test {
   // Starts the fixture with `options` and waits for its "ready".
   void StartDevice(const std::string& options) {
     const std::string ready = (dir_ / "ready").string();
+    // A second fixture in one test: the first one's "ready" must not count.
+    std::filesystem::remove(ready);
     const std::string command = std::string("exec '") + FDSURF_PTY_DEVICE + "' --link '" + link_ +
                                 "' --report '" + (dir_ / "report").string() +
                                 "' --time-limit-s 40 " + options + " >'" + ready + "'";
