@@ -8,14 +8,21 @@
       [--scenario plain|stop|hangup|corrupt] [--job-args "--fit 20x15 --speed 20"] \\
       --harness build/boards/mega2560-ramps/host/fdsurf_simavr_board --elf FILE.elf
 
-1. the simulated plotter runs the job at the board's tick rate and writes the
+1. the harness starts the board (--elf, --uart-socket, --waveform rec.wave,
+   --measures measures.tsv) and the relay puts its UART on a kernel pty
+   behind a symlink LINK;
+2. `fdsurf ports --probe LINK` sends HELLO through the relay: the board's
+   tick rate;
+3. the simulated plotter runs the job at that tick rate and writes the
    reference waveform (`fdsurf stream JOB --device sim --waveform ref.wave`);
-2. the harness starts the board (--elf, --uart-socket, --waveform rec.wave)
-   and the relay puts its UART on a kernel pty behind a symlink;
-3. the real host tool streams the same job with the same options to
+4. the real host tool streams the same job with the same options to
    `--device serial:LINK:BAUD`;
-4. the harness is stopped (SIGTERM: it writes the waveform) and the checker
-   compares rec.wave with ref.wave.
+5. the harness is stopped (SIGTERM: it writes the waveform and the
+   measures), the checker compares rec.wave with ref.wave, and the board's
+   own promises are checked: its measures (BOARDS' limits: no late tick, no
+   fault, the stack fits with margin ...; the measured tick rate is HELLO's),
+   every ENABLE released at reset, and a servo pen's pulses exactly the
+   profile's widths, one period apart.
 
 Scenarios: plain; stop (SIGINT to fdsurf mid-job: it sends STOP, waits for
 rest, exits 130; the recording must be a prefix of the reference, pen up, at
@@ -26,6 +33,7 @@ of the logs are printed. Exit 0 pass, 1 fail, 2 bad usage.
 """
 import argparse
 import os
+import re
 import select
 import shlex
 import signal
@@ -34,20 +42,92 @@ import sys
 import tempfile
 import time
 
-# Per board: the tick rate its HELLO reports (the reference runs at it), the
-# baud of its UART, the step timing its drivers need (RAMPS: DRV8825, 1.9 µs
-# pulse and 650 ns DIR set-up; A4988 elsewhere: 1 µs, 200 ns) and the short
-# CI job's options (the speed at most one step per tick; about 6 s of
-# machine time).
+SCENARIOS = ("plain", "stop", "hangup", "corrupt")
+
+
+class Limit:
+    """One promise about a harness's measures (its --measures TSV): the value
+    `of(measures)` compared with `bound` by `op` ("==", "<=" or ">="), in the
+    scenarios listed (default all of them), with why it must hold."""
+
+    def __init__(self, label, op, bound, why, scenarios=SCENARIOS, of=None):
+        self.label = label
+        self.op = op
+        self.bound = bound
+        self.why = why
+        self.scenarios = scenarios
+        self.of = of or (lambda measures: measures[label])
+
+    def holds(self, value):
+        return {"==": value == self.bound, "<=": value <= self.bound,
+                ">=": value >= self.bound}[self.op]
+
+
+def stack_margin(high_water, space):
+    """The bytes of stack space the painted high-water mark left untouched."""
+    return lambda measures: measures[space] - measures[high_water]
+
+
+# Mega 2560 (fdsurf_simavr_board --measures, boards/mega2560-ramps/README.md).
+# The hang-up and the corrupt burst change what arrives, not what the board
+# must keep: the relay holds the socket, so the board keeps running (no DTR
+# reset under the emulator; a reset would make the resume fail anyway), and
+# flipped bytes are refused by the frame check, never executed. So every
+# limit holds in every scenario; STOP decelerates within the job's limits.
+# What does differ is the step interrupt's worst latency (about 400 cycles
+# plain, up to 3 300 of the 8 000-cycle period after a hang-up or a burst, as
+# the resent frames arrive together), so the limit is on late ticks, not on it.
+MEGA_LIMITS = [
+    Limit("late_ticks", "==", 0, "no step interrupt began a period after its compare match"),
+    Limit("lost_ticks", "==", 0, "no compare match lost (2000 Hz is the rate it holds)"),
+    Limit("watchdog_resets", "==", 0, "the main loop never stalled for the watchdog"),
+    Limit("boots", "==", 1, "one start: no reset mid-job (a resume after one is refused)"),
+    Limit("stack_high_water", ">=", 512, "the paint was read: the job used the stack"),
+    Limit("ram_never_used", ">=", 256, "the stack stays 256 B clear of the static RAM"),
+]
+
+# micro:bit v1 (run_qemu.py --measures, boards/microbit-v1/README.md). Late
+# or missed ticks at rest (a pen change's wait, a PATCH validation) shift no
+# step edge, so only the late ticks while moving count (every scenario shows
+# one missed tick at rest, the board does not promise otherwise). The
+# receive ring must never overflow while the host streams normally (plain,
+# stop); after a hang-up the host resends what was unacknowledged, after a
+# corrupt burst what the board refused, in one go, and the 2 KB ring holds
+# that too, so the limit is the same there. The relay flips bytes, not the
+# line's framing, so no scenario may show a UART error.
+MICROBIT_LIMITS = [
+    Limit("fault", "==", 0, "no fault handler ran"),
+    Limit("late_moving_ticks", "==", 0, "no tick late while moving (a step edge moved)"),
+    Limit("rx_overruns", "==", 0, "no received byte dropped by a full ring"),
+    Limit("uart_errors", "==", 0, "no framing or overrun error in the UART"),
+    Limit("stack_high_water_bytes", ">=", 512, "the paint was read: the job used the stack"),
+    Limit("stack margin", ">=", 1024, "1 KB of the stack space never touched",
+          of=stack_margin("stack_high_water_bytes", "stack_space_bytes")),
+]
+
+# Per board: the baud of its UART, the step timing its drivers need (RAMPS:
+# DRV8825, 1.9 us pulse and 650 ns DIR set-up; A4988 elsewhere: 1 us, 200 ns),
+# the pen servo's profile widths (us, up and down; None: a pen line), the
+# limits on its measures (None: its harness writes none), and the short CI
+# job's options (about 6 s of machine time, the speed at most one step per
+# tick of the board; the tick rate itself comes from the board's HELLO).
 BOARDS = {
-    "mega2560-ramps": {"tick_hz": 2000, "baud": 115200, "min_pulse_ns": 1900,
-                       "min_dir_setup_ns": 650,
+    "mega2560-ramps": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
+                       "servo_us": (1000, 2000), "limits": MEGA_LIMITS,
                        "job_args": "--fit 20x15 --lines 2 --speed 20"},
-    "microbit-v1": {"tick_hz": 20000, "baud": 115200, "min_pulse_ns": 1000,
-                    "min_dir_setup_ns": 200, "job_args": "--fit 40x30 --lines 2"},
-    "standin": {"tick_hz": 10000, "baud": 115200, "min_pulse_ns": 1900,
-                "min_dir_setup_ns": 650, "job_args": "--fit 40x30 --lines 2"},
+    "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
+                    "servo_us": None, "limits": MICROBIT_LIMITS,
+                    "job_args": "--fit 40x30 --lines 2"},
+    "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
+                "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 2"},
 }
+# A servo pulse starts every 20 ms (50 Hz); under simavr a width written at a
+# period's start can shift that start by the interrupt latency, and servos
+# take 40-60 Hz anyway. A width within 2 us of the profile's is exact (the
+# waveform's 62.5 ns cycle and the rounding to us).
+SERVO_PERIOD_NS = 20_000_000
+SERVO_PERIOD_SLACK_NS = 1_000_000
+SERVO_WIDTH_SLACK_US = 2
 
 
 class Failure(Exception):
@@ -133,13 +213,29 @@ def run_logged(processes, name, command, timeout_s):
             raise Failure("%s did not finish within %d s" % (name, timeout_s))
 
 
-def reference(args, processes, board, ref):
+def reference(args, processes, tick_hz, ref):
+    """The simulated plotter at the board's tick rate; returns its machine time."""
     command = [args.fdsurf, "stream", args.job, "--device", "sim", "--waveform", ref,
-               "--tick-hz", str(board["tick_hz"]), "-q"] + args.job_args
+               "--tick-hz", str(tick_hz), "-q"] + args.job_args
     code = run_logged(processes, "reference", command, 120)
     if code != 0:
         raise Failure("the reference run (fdsurf stream --device sim) exited with %d" % code)
     return reference_duration_s(ref)
+
+
+def probe_tick_hz(args, processes, link, baud):
+    """The tick rate the board's HELLO reports (`fdsurf ports --probe LINK`)."""
+    command = [args.fdsurf, "ports", "--probe", "--baud", str(baud), "--timeout", "5", link]
+    code = run_logged(processes, "probe", command, 60)
+    with open(os.path.join(processes.workdir, "probe.log")) as f:
+        lines = f.read().splitlines()[1:]
+    names = {link, os.path.realpath(link)}
+    for line in lines:
+        answer = re.search(r"fdsurf protocol \d+, \d+ axes, (\d+) Hz ticks", line)
+        if line.split()[:1] and line.split()[0] in names and answer:
+            return int(answer.group(1))
+    raise Failure("no HELLO reply from the board on %s (fdsurf ports --probe exited with %d)" %
+                  (link, code))
 
 
 def reference_duration_s(ref):
@@ -159,11 +255,16 @@ def relay_options(args):
     return []
 
 
+def stream_timeout_s(duration_s):
+    """How long the serial run may take: 4 x the machine time, plus connecting."""
+    return int(duration_s * 4 + 90)
+
+
 def stream(args, processes, board, link, duration_s):
     """The real host tool over the serial line; STOP mid-job for `stop`."""
     command = [args.fdsurf, "stream", args.job, "--device",
                "serial:%s:%d" % (link, board["baud"]), "-q"] + args.job_args
-    timeout_s = int(duration_s * 4 + 90)
+    timeout_s = stream_timeout_s(duration_s)
     if args.scenario != "stop":
         code = run_logged(processes, "fdsurf", command, timeout_s)
         if code != 0:
@@ -184,22 +285,158 @@ def stream(args, processes, board, link, duration_s):
         raise Failure("fdsurf exited with %d after SIGINT, expected 130 (stopped)" % code)
 
 
+def read_measures(path):
+    """A harness's measures TSV (a header row, then measure, value, unit ...)."""
+    measures = {}
+    try:
+        with open(path) as f:
+            rows = f.read().splitlines()[1:]
+    except OSError as error:
+        raise Failure("%s: no measures from the harness (%s)" % (path, error.strerror))
+    for number, row in enumerate(rows, 2):
+        fields = row.split("\t")
+        try:
+            measures[fields[0]] = float(fields[1])
+        except (IndexError, ValueError):
+            raise Failure("%s:%d: not 'measure<TAB>value<TAB>...': %r" % (path, number, row))
+    return measures
+
+
+def check_measures(measures, limits, scenario, hello_tick_hz, path):
+    """The board's limits for `scenario`, and that the tick rate it measured
+    is the one its HELLO reported; returns the lines to print, raises Failure
+    listing every limit that does not hold."""
+    report, broken = [], []
+    for limit in limits:
+        if scenario not in limit.scenarios:
+            continue
+        try:
+            value = limit.of(measures)
+        except KeyError as key:
+            raise Failure("%s: no measure %s (the harness's keys changed?)" % (path, key))
+        line = "%s %g (%s %g: %s)" % (limit.label, value, limit.op, limit.bound, limit.why)
+        (report if limit.holds(value) else broken).append(line)
+    if "tick_hz" not in measures:
+        raise Failure("%s: no measure tick_hz" % path)
+    if abs(measures["tick_hz"] - hello_tick_hz) >= 0.5:
+        broken.append("tick_hz %g, but HELLO reported %d Hz" % (measures["tick_hz"],
+                                                                 hello_tick_hz))
+    else:
+        report.append("tick_hz %g (HELLO's)" % measures["tick_hz"])
+    if broken:
+        raise Failure("the board's measures (%s) break its limits: %s" % (path,
+                                                                          "; ".join(broken)))
+    return report
+
+
+def read_transitions(path):
+    """The header lines and the (time_ns, signal, level) lines of a waveform."""
+    header, transitions = [], []
+    with open(path) as f:
+        for number, line in enumerate(f, 1):
+            if line.startswith("#"):
+                header.append(line.strip())
+                continue
+            fields = line.split()
+            if len(fields) != 3 or fields[2] not in ("0", "1"):
+                raise Failure("%s:%d: not '<time_ns> <SIGNAL> <0|1>': %r" % (path, number, line))
+            transitions.append((int(fields[0]), fields[1], int(fields[2])))
+    return header, transitions
+
+
+def header_value(header, key):
+    """The words after `# KEY` in a waveform header, or None."""
+    for line in header:
+        words = line[1:].split()
+        if words[:1] == [key]:
+            return words[1:]
+    return None
+
+
+def check_enable_released(header, transitions):
+    """Every ENABLE line starts at its inactive level: the firmware releases
+    the motors first thing after a reset."""
+    active = int(header_value(header, "enable_active_level")[0])
+    first = {}
+    for time_ns, name, level in transitions:
+        if name.endswith("_EN") and name not in first:
+            first[name] = (time_ns, level)
+    if not first:
+        raise Failure("the recording has no ENABLE line")
+    for name, (time_ns, level) in sorted(first.items()):
+        if level == active:
+            raise Failure("%s starts active (%d at %d ns): the motors are energised before "
+                          "the firmware set them up" % (name, level, time_ns))
+    return "%s released at reset" % " ".join(sorted(first))
+
+
+def check_servo(header, transitions, servo_us):
+    """A servo pen: the header names the profile's widths, every pulse is
+    exactly one of them, pulses start one period apart, and both were seen
+    (the pen went down and up)."""
+    declared = header_value(header, "pen")
+    if declared != ["servo"] + [str(us) for us in servo_us]:
+        raise Failure("the recording's header says '# pen %s', the profile 'servo %d %d'" %
+                      (" ".join(declared or []), servo_us[0], servo_us[1]))
+    seen, rise, last_rise = set(), None, None
+    for time_ns, name, level in transitions:
+        if name != "SERVO":
+            continue
+        if level == 1:
+            if last_rise is not None and abs(time_ns - last_rise - SERVO_PERIOD_NS) > \
+                    SERVO_PERIOD_SLACK_NS:
+                raise Failure("servo pulses %d ns apart at %d ns, not %d" %
+                              (time_ns - last_rise, time_ns, SERVO_PERIOD_NS))
+            rise = last_rise = time_ns
+        elif rise is not None:
+            width_us = (time_ns - rise) / 1000
+            nearest = min(servo_us, key=lambda us: abs(us - width_us))
+            if abs(width_us - nearest) > SERVO_WIDTH_SLACK_US:
+                raise Failure("a servo pulse of %.1f us at %d ns: not up/down %s us" %
+                              (width_us, rise, servo_us))
+            seen.add(nearest)
+            rise = None
+    if seen != set(servo_us):
+        raise Failure("servo pulses of %s us only, expected both %s" % (sorted(seen), servo_us))
+    return "servo pulses %d/%d us every 20 ms" % servo_us
+
+
+def check_board(args, board, rec, measures_path, hello_tick_hz):
+    """What the board promises beyond the comparison with the simulator."""
+    header, transitions = read_transitions(rec)
+    report = [check_enable_released(header, transitions)]
+    if board["servo_us"]:
+        report.append(check_servo(header, transitions, board["servo_us"]))
+    if board["limits"] is not None:
+        report += check_measures(read_measures(measures_path), board["limits"], args.scenario,
+                                 hello_tick_hz, measures_path)
+    for line in report:
+        print("run_e2e: ok: %s" % line)
+
+
 def run(args, processes):
-    board = dict(BOARDS[args.board])
-    if args.tick_hz:
-        board["tick_hz"] = args.tick_hz
+    """One scenario: board, probe, reference, stream, then the checks."""
+    board = BOARDS[args.board]
     work = processes.workdir
     ref = os.path.join(work, "ref.wave")
     rec = os.path.join(work, "rec.wave")
+    measures = os.path.join(work, "measures.tsv")
     sock = os.path.join(work, "uart.sock")
     link = os.path.join(work, "ttyBOARD")
-    duration_s = reference(args, processes, board, ref)
     harness = args.harness + ["--elf", args.elf, "--uart-socket", sock, "--waveform", rec,
-                              "--time-limit-s", str(int(duration_s * 4 + 120))]
+                              "--time-limit-s", str(args.time_limit_s)]
+    if board["limits"] is not None:
+        harness += ["--measures", measures]
     processes.start("harness", harness, 60)
     processes.start("relay", [sys.executable, args.relay, "--socket", sock, "--link", link]
                     + relay_options(args), 30)
     time.sleep(args.settle_s)
+    tick_hz = probe_tick_hz(args, processes, link, board["baud"])
+    duration_s = reference(args, processes, tick_hz, ref)
+    needed_s = stream_timeout_s(duration_s) + 30
+    if needed_s > args.time_limit_s:
+        raise Failure("the job takes %.0f s of machine time: the harness needs --time-limit-s "
+                      "%d or more, not %d" % (duration_s, needed_s, args.time_limit_s))
     stream(args, processes, board, link, duration_s)
     time.sleep(0.5)  # the last pin changes after the last acknowledgement
     processes.stop("relay")
@@ -221,6 +458,7 @@ def run(args, processes):
         sys.stdout.write(f.read())
     if code != 0:
         raise Failure("the recorded waveform differs from the reference (checker exit %d)" % code)
+    check_board(args, board, rec, measures, tick_hz)
 
 
 def parse():
@@ -237,8 +475,10 @@ def parse():
                         help="fdsurf stream options of both runs, one string (default: the "
                              "board's short job)")
     parser.add_argument("--scenario", default="plain",
-                        choices=["plain", "stop", "hangup", "corrupt"])
-    parser.add_argument("--tick-hz", type=int, help="override the board's tick rate")
+                        choices=SCENARIOS)
+    parser.add_argument("--time-limit-s", type=int, default=240,
+                        help="the harness's own time limit, should this driver die (default "
+                             "240 s; a job needs 4 x its machine time + 120 s)")
     parser.add_argument("--disturb-after", type=int, default=600,
                         help="hangup/corrupt: bytes towards the board before it happens")
     parser.add_argument("--stop-after-s", type=float, help="stop: seconds before the SIGINT")

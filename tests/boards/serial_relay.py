@@ -115,10 +115,12 @@ class Relay:
             self.hang_up()
 
     def hang_up(self):
+        """Unplugs: LINK goes first (as udev removes /dev/serial/by-id/...), then
+        the pty, so a host that sees the hang-up never finds the old LINK."""
         self.hung_up = True
+        os.unlink(self.args.link)
         self.pty.close()
         self.pty = None
-        os.unlink(self.args.link)  # as udev removes /dev/serial/by-id/... on an unplug
         self.replug_at = time.monotonic() + self.args.hangup_for
         log("hung up after %d bytes towards the board; back in %.1f s" %
             (self.to_board, self.args.hangup_for))

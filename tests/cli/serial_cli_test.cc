@@ -78,6 +78,8 @@ class SerialCli : public ::testing::Test {
   // Starts the fixture with `options` and waits for its "ready".
   void StartDevice(const std::string& options) {
     const std::string ready = (dir_ / "ready").string();
+    // A second fixture in one test: the first one's "ready" must not count.
+    std::filesystem::remove(ready);
     const std::string command = std::string("exec '") + FDSURF_PTY_DEVICE + "' --link '" + link_ +
                                 "' --report '" + (dir_ / "report").string() +
                                 "' --time-limit-s 40 " + options + " >'" + ready + "'";
@@ -274,6 +276,12 @@ TEST_F(SerialCli, PortsProbeShowsWhatAnswered) {
   EXPECT_NE(row.find(" pty "), std::string::npos) << row;
   EXPECT_NE(row.find("fdsurf protocol 2, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
       << row;
+  // The machine's own ports (if any are listed) are shown, not opened.
+  std::istringstream rows(r.out);
+  for (std::string other; std::getline(rows, other);) {
+    if (other.rfind("PORT", 0) == 0 || other.find(link_) != std::string::npos) continue;
+    EXPECT_NE(other.find("(not probed)"), std::string::npos) << other;
+  }
 }
 
 TEST_F(SerialCli, PortsProbeOfASilentPortSaysSoAndExits3) {

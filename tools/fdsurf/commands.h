@@ -57,8 +57,9 @@ struct PortsOptions {
 void AddPortsOptions(CLI::App* command, PortsOptions* options);
 
 /// `ports`: a table of the serial ports (and the PATHs given), with --probe
-/// what answered HELLO on each. 0, or 3 for a PATH that does not exist, or
-/// when --probe found no port that answers.
+/// what answered HELLO on each (only on the PATHs, when some are given). 0,
+/// or 3 for a PATH that does not exist, or when --probe found no port that
+/// answers.
 int RunPorts(const PortsOptions& options);
 
 /// Adds the options of `plot` (or, with `render_only`, of `render`).

@@ -55,8 +55,8 @@ void AddPortsOptions(CLI::App* command, PortsOptions* o) {
   command->add_option("PATH", o->paths,
                       "ports to show besides the listed ones (a pty, which is never listed)");
   command->add_flag("--probe", o->probe,
-                    "send HELLO on each port and show what answered (opening an Arduino's port "
-                    "resets it)");
+                    "send HELLO on each port (only the PATHs, when some are given) and show "
+                    "what answered (opening an Arduino's port resets it)");
   command->add_option("--baud", o->baud, "--probe: the baud")
       ->check(CLI::Range(50, 4000000))
       ->capture_default_str();
@@ -85,11 +85,16 @@ int RunPorts(const PortsOptions& o) {
   std::vector<std::vector<std::string>> rows{
       {"PORT", "TRANSPORT", "VID:PID", "SERIAL", "MANUFACTURER", "PRODUCT", "BY-ID"}};
   if (o.probe) rows[0].push_back("ANSWER");
+  // With ports named, only those are probed: opening the others would reset
+  // any Arduino among them and cost the timeout on each.
+  const std::size_t probed = o.paths.empty() ? ports.size() : o.paths.size();
   int answering = 0;
-  for (const hal::SerialPortInfo& port : ports) {
+  for (std::size_t i = 0; i < ports.size(); ++i) {
+    const hal::SerialPortInfo& port = ports[i];
     rows.push_back({port.path, port.transport, OrDash(port.VidPid()), OrDash(port.usb_serial),
                     OrDash(port.manufacturer), OrDash(port.product), OrDash(port.by_id)});
-    if (o.probe) {
+    if (o.probe && i >= probed) rows.back().push_back("(not probed)");
+    if (o.probe && i < probed) {
       bool answered = false;
       rows.back().push_back(Probe(port.path, o, &answered));
       answering += answered ? 1 : 0;

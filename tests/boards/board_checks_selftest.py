@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""The check of run_e2e.py's board checks, without an emulator: a board's
+measures as its harness writes them pass, and each broken promise fails
+(every limit of BOARDS broken on its own, a tick rate that is not HELLO's, a
+missing measure); a servo pen's pulses at the profile's widths one period
+apart pass, and a wrong width, a missed period, a pen that never went down,
+a header with other widths, or an ENABLE that starts active fail.
+
+  board_checks_selftest.py   (run_e2e.py beside it)
+"""
+import os
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import run_e2e  # noqa: E402
+
+# Measures of real plain runs (the keys the limits read, values as measured).
+GOOD = {
+    "mega2560-ramps": {"tick_hz": 2000, "late_ticks": 0, "lost_ticks": 0, "watchdog_resets": 0,
+                       "boots": 1, "stack_high_water": 2301, "ram_never_used": 815},
+    "microbit-v1": {"tick_hz": 20000, "fault": 0, "late_moving_ticks": 0, "rx_overruns": 0,
+                    "uart_errors": 0, "stack_high_water_bytes": 2600,
+                    "stack_space_bytes": 7740},
+}
+# Limits whose value is not one measure: how to break them.
+DERIVED = {"stack margin": {"stack_high_water_bytes": 7000}}
+
+failures = []
+
+
+def expect(what, passes, check):
+    """Runs `check`; records a failure unless it passed (or failed) as expected."""
+    try:
+        check()
+        outcome = True
+    except run_e2e.Failure as failure:
+        outcome = False
+        detail = str(failure)
+    if outcome != passes:
+        failures.append("%s: %s" % (what, "passed" if outcome else "failed: " + detail))
+    elif not passes:
+        print("caught: %s: %s" % (what, detail))
+
+
+def breaking(limit, measures):
+    """`measures` with the one value changed that breaks `limit`."""
+    if limit.label in DERIVED:
+        return dict(measures, **DERIVED[limit.label])
+    step = {"==": 1, ">=": -1, "<=": 1}[limit.op]
+    return dict(measures, **{limit.label: limit.bound + step})
+
+
+def check_limits():
+    for board, good in GOOD.items():
+        limits = run_e2e.BOARDS[board]["limits"]
+        hello = good["tick_hz"]
+        for scenario in run_e2e.SCENARIOS:
+            expect("%s %s: its measures" % (board, scenario), True,
+                   lambda s=scenario: run_e2e.check_measures(good, limits, s, hello, "good"))
+        for limit in limits:
+            bad = breaking(limit, good)
+            expect("%s: %s broken" % (board, limit.label), False,
+                   lambda m=bad, s=limit.scenarios[0]: run_e2e.check_measures(
+                       m, limits, s, hello, "perturbed"))
+        expect("%s: HELLO says another tick rate" % board, False,
+               lambda: run_e2e.check_measures(good, limits, "plain", hello // 2, "good"))
+        missing = {k: v for k, v in good.items() if k != limits[0].label}
+        expect("%s: a measure missing" % board, False,
+               lambda: run_e2e.check_measures(missing, limits, "plain", hello, "missing"))
+
+
+def servo_waveform(widths_us, gaps_ns=None, enable_start=1, pen="servo 1000 2000"):
+    """A Mega-like recording: ENABLE lines, then one servo pulse per width."""
+    lines = ["# fdsurf-waveform 1", "# board mega2560-ramps", "# dir_negative_level 1",
+             "# enable_active_level 0", "# pen %s" % pen,
+             "0 X_EN %d" % enable_start, "0 Y_EN 1", "0 SERVO 0"]
+    time_ns = 1_000_000
+    for i, width in enumerate(widths_us):
+        lines.append("%d SERVO 1" % time_ns)
+        lines.append("%d SERVO 0" % (time_ns + width * 1000))
+        time_ns += (gaps_ns or {}).get(i, run_e2e.SERVO_PERIOD_NS)
+    return "\n".join(lines) + "\n"
+
+
+def check_pins(workdir):
+    good = [1000] * 5 + [2000] * 5 + [1000] * 3
+    cases = [
+        ("a servo pen at 1000/2000 us every 20 ms", True, servo_waveform(good)),
+        ("a 1500 us servo pulse", False, servo_waveform(good[:6] + [1500] + good[7:])),
+        ("servo pulses 25 ms apart", False, servo_waveform(good, gaps_ns={4: 25_000_000})),
+        ("a pen that never went down", False, servo_waveform([1000] * 8)),
+        ("a header with other widths", False, servo_waveform(good, pen="servo 900 2100")),
+        ("an ENABLE that starts active", False, servo_waveform(good, enable_start=0)),
+    ]
+    for what, passes, text in cases:
+        path = os.path.join(workdir, "case.wave")
+        with open(path, "w") as f:
+            f.write(text)
+
+        def check(p=path):
+            header, transitions = run_e2e.read_transitions(p)
+            run_e2e.check_enable_released(header, transitions)
+            run_e2e.check_servo(header, transitions, (1000, 2000))
+        expect(what, passes, check)
+
+
+def main():
+    check_limits()
+    with tempfile.TemporaryDirectory() as workdir:
+        check_pins(workdir)
+        path = os.path.join(workdir, "measures.tsv")
+        with open(path, "w") as f:
+            f.write("measure\tvalue\tunit\nlate_ticks\t0\tticks\nboots\tone\tstarts\n")
+        expect("a measures TSV with a value that is no number", False,
+               lambda: run_e2e.read_measures(path))
+    for failure in failures:
+        print("FAIL: %s" % failure)
+    print("board_checks_selftest: %s" % ("FAIL" if failures else "PASS"))
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
