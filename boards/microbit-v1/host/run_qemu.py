@@ -40,9 +40,12 @@ that paces the UART bytes.
 """
 import argparse
 import collections
+import ctypes
+import functools
 import mmap
 import os
 import re
+import resource
 import selectors
 import shutil
 import signal
@@ -59,6 +62,7 @@ DEFAULT_PLUGIN = os.path.join(REPO, "build", "boards", "microbit-v1", "host",
                               "libfdsurf_microbit_pins.so")
 
 ICOUNT_SHIFT = 6
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 NS_PER_INSN = 1 << ICOUNT_SHIFT
 RAM_BASE = 0x20000000
 RAM_SIZE = 16 * 1024
@@ -192,9 +196,22 @@ def build_plugin(directory):
     return out
 
 
+def bound_qemu(time_limit_s):
+    """In the QEMU child before exec: it dies with this harness (SIGKILL when
+    the harness exits, however it exits, even by SIGKILL) and may use at most
+    the time limit + 30 s of CPU (the kernel kills it then). A `timeout`
+    wrapper did not do this: killing the wrapper left QEMU running."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL) != 0:
+        os._exit(127)
+    if os.getppid() == 1:  # the harness died before prctl
+        os._exit(127)
+    cpu_s = int(time_limit_s) + 30
+    resource.setrlimit(resource.RLIMIT_CPU, (cpu_s, cpu_s + 5))
+
+
 def qemu_command(args, work, plugin):
-    return ["timeout", "--signal=KILL", str(int(args.time_limit_s) + 30), args.qemu,
-            "-M", "microbit", "-kernel", args.elf, "-nographic",
+    return [args.qemu, "-M", "microbit", "-kernel", args.elf, "-nographic",
             "-icount", f"shift={ICOUNT_SHIFT},align=on,sleep=on",
             "-chardev", f"socket,id=uart,path={work}/uart.sock,server=on,wait=off",
             "-serial", "chardev:uart",
@@ -263,7 +280,9 @@ class Harness:
         open(f"{self.work}/qemu.log", "w").close()
         self.qemu = subprocess.Popen(qemu_command(self.args, self.work, plugin),
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                     stderr=open(f"{self.work}/qemu.stderr", "w"))
+                                     stderr=open(f"{self.work}/qemu.stderr", "w"),
+                                     preexec_fn=functools.partial(bound_qemu,
+                                                                  self.args.time_limit_s))
         deadline = time.monotonic() + 10
         self.uart = connect_unix(f"{self.work}/uart.sock", deadline, self.qemu)
         self.uart.setblocking(False)
