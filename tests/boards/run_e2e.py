@@ -32,6 +32,7 @@ the same waveform). Every process runs under a timeout; on failure the tails
 of the logs are printed. Exit 0 pass, 1 fail, 2 bad usage.
 """
 import argparse
+import ctypes
 import os
 import re
 import select
@@ -130,6 +131,17 @@ SERVO_PERIOD_SLACK_NS = 1_000_000
 SERVO_WIDTH_SLACK_US = 2
 
 
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def die_with_parent():
+    """In each child before exec: SIGKILL when this driver ends, however it
+    ends (CTest's timeout kills the driver alone), so no emulator, relay or
+    fdsurf outlives a run."""
+    if ctypes.CDLL(None).prctl(PR_SET_PDEATHSIG, signal.SIGKILL) != 0 or os.getppid() == 1:
+        os._exit(127)
+
+
 class Failure(Exception):
     pass
 
@@ -151,7 +163,7 @@ class Processes:
         """Starts `command`, waits for its `ready` line on stdout."""
         err = open(self.log_path(name), "w")
         process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=err,
-                                   start_new_session=True)
+                                   start_new_session=True, preexec_fn=die_with_parent)
         self.running.append((name, process))
         deadline = time.monotonic() + wait_ready_s
         out = process.stdout.fileno()
@@ -208,7 +220,7 @@ def run_logged(processes, name, command, timeout_s):
         log.flush()
         try:
             return subprocess.run(command, stdout=log, stderr=subprocess.STDOUT,
-                                  timeout=timeout_s).returncode
+                                  timeout=timeout_s, preexec_fn=die_with_parent).returncode
         except subprocess.TimeoutExpired:
             raise Failure("%s did not finish within %d s" % (name, timeout_s))
 
@@ -271,7 +283,8 @@ def stream(args, processes, board, link, duration_s):
             raise Failure("fdsurf stream over serial exited with %d" % code)
         return
     with open(processes.log_path("fdsurf"), "w") as log:
-        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
+        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT,
+                                   preexec_fn=die_with_parent)
         time.sleep(args.stop_after_s if args.stop_after_s else 2 + duration_s * 0.4)
         if process.poll() is not None:
             raise Failure("fdsurf finished (exit %d) before the STOP" % process.returncode)
