@@ -332,7 +332,7 @@ TEST_F(Cli, StreamChargesTheDevicesComputeTimeOnRequest) {
 TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   ExpectRefused("stream '" + kTeapot + "' --device serial", "--device: 'serial' is not sim");
   ExpectRefused("stream '" + kTeapot + "' --device usb --faults 0.1",
-                "--svg, --png, --faults and --sim-cost are for --device sim");
+                "--svg, --png, --waveform, --faults and --sim-cost are for --device sim");
   ExpectRefused("stream '" + kTeapot + "' --sim-cost z80", "--sim-cost");
   ExpectRefused("stream '" + kTeapot + "' --travel 100x100", "--travel X 100 mm is smaller than");
   ExpectRefused("stream '" + kTeapot + "' --tolerance 0.005", "--tolerance 0.005 mm is too small");
