@@ -17,6 +17,8 @@
 // A test instrument, not a user command: it lives with the end-to-end tests
 // (tests/boards/) and links only the simulator box.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -163,10 +165,30 @@ MotionReport CheckRecordedMotion(const DecodedWaveform& rec, MotionLimitsSi limi
   }
   std::vector<hal::PenEvent> pens = rec.pen_events;
   std::uint64_t last_step_us = 0;
+  std::uint64_t previous_step_us = 0;
   for (const hal::StepDirEvent& e : rec.step_events) {
-    if (e.axis_mask != 0) last_step_us = e.time_us;
+    if (e.axis_mask == 0) continue;
+    previous_step_us = last_step_us;
+    last_step_us = e.time_us;
   }
-  const std::uint64_t end_us = last_step_us + 1'000'000 / limits.tick_hz;
+  // Where the motion came to rest: after its last step a correct stop still
+  // decelerates over less than one step, which at the acceleration limit a
+  // takes at most sqrt(2 / a) (x = a t^2 / 2 <= 1 step), and no longer than
+  // v / a from the speed v it had (about one step per the last interval),
+  // plus a tick of quantisation. Taking the last step itself as the rest
+  // would hold a correct deceleration to a law it cannot meet; the bound
+  // still catches a stop that is too abrupt (at speed, v / a is far longer
+  // than sqrt(2 / a)).
+  std::uint64_t settle_us = 1'000'000 / limits.tick_hz;
+  if (limits.accel > 0) {
+    double settle_s = std::sqrt(2.0 / limits.accel);
+    if (previous_step_us != 0 && last_step_us > previous_step_us) {
+      const double speed = 1e6 / static_cast<double>(last_step_us - previous_step_us);
+      settle_s = std::min(settle_s, speed / limits.accel);
+    }
+    settle_us += static_cast<std::uint64_t>(settle_s * 1e6);
+  }
+  const std::uint64_t end_us = last_step_us + settle_us;
   if (pens.empty() || pens.back().time_us < end_us) {
     pens.push_back(hal::PenEvent{end_us, pens.empty() ? false : pens.back().down});
   }
