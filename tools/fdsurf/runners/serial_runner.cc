@@ -20,6 +20,20 @@ TransportLoopOptions LoopOptions(const std::string& path, std::uint32_t connect_
   return options;
 }
 
+// Opens the port and puts the link's loop on it; nothing is sent yet.
+std::optional<SerialSession> OpenSession(const std::string& path, std::uint32_t baud,
+                                         const TransportLoopOptions& loop_options,
+                                         std::string* error) {
+  SerialSession session;
+  hal::SerialOptions options;
+  options.baud = baud;
+  if (hal::SerialTransport::Open(path, options, &session.port, error) != hal::IoStatus::kOk) {
+    return std::nullopt;
+  }
+  session.loop = std::make_unique<TransportLoop>(*session.port, loop_options);
+  return session;
+}
+
 // serial:auto: every listed port is probed; exactly one must answer.
 SerialSession FindTheOneBoard(const StreamOptions& o, std::uint32_t baud) {
   std::vector<SerialSession> answered;
@@ -60,16 +74,11 @@ std::optional<SerialSession> ProbeSerialPort(const std::string& path, std::uint3
                                              std::uint32_t connect_timeout_ms, bool quiet,
                                              std::string* error, bool* interrupted) {
   *interrupted = false;
-  SerialSession session;
-  hal::SerialOptions options;
-  options.baud = baud;
-  if (hal::SerialTransport::Open(path, options, &session.port, error) != hal::IoStatus::kOk) {
-    return std::nullopt;
-  }
-  session.loop = std::make_unique<TransportLoop>(*session.port,
-                                                 LoopOptions(path, connect_timeout_ms, 0, quiet));
+  std::optional<SerialSession> session =
+      OpenSession(path, baud, LoopOptions(path, connect_timeout_ms, 0, quiet), error);
+  if (!session) return std::nullopt;
   try {
-    if (!session.loop->Connect()) {
+    if (!session->loop->Connect()) {
       *interrupted = true;
       *error = "serial " + path + ": interrupted";
       return std::nullopt;
@@ -90,16 +99,13 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   if (spec.automatic) {
     session = FindTheOneBoard(o, spec.baud);
   } else {
-    hal::SerialOptions options;
-    options.baud = spec.baud;
-    if (hal::SerialTransport::Open(spec.path, options, &session.port, &error) !=
-        hal::IoStatus::kOk) {
-      throw DeviceError(error);
-    }
-    session.loop = std::make_unique<TransportLoop>(
-        *session.port, LoopOptions(spec.path, Milliseconds(o.connect_timeout_s),
-                                   Milliseconds(o.reconnect_timeout_s), o.quiet));
+    std::optional<SerialSession> opened =
+        OpenSession(spec.path, spec.baud,
+                    LoopOptions(spec.path, Milliseconds(o.connect_timeout_s), 0, o.quiet), &error);
+    if (!opened) throw DeviceError(error);
+    session = std::move(*opened);
   }
+  // Probing connects without reconnecting; the job reconnects after an unplug.
   TransportLoop& loop = *session.loop;
   loop.set_reconnect_timeout_ms(Milliseconds(o.reconnect_timeout_s));
   if (!loop.Connect()) {
