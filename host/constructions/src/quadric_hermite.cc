@@ -9,8 +9,10 @@
 #include <numbers>
 
 #include "fdsurf/host/constructions.h"
+#include "fdsurf/host/errors.h"
 #include "fdsurf/host/text.h"
 #include "fdsurf/host/vec3.h"
+#include "quadric_pieces.h"
 
 namespace fdsurf::host {
 namespace {
@@ -186,25 +188,8 @@ QuadricSolution SolveQuadricTriangle(const std::array<Point3, 3>& p,
   return solution;
 }
 
-namespace {
 
-// Drawing (docs/constructions.md, row 12): a piece hangs from its
-// triangle on the side of its oriented normal N. It is sliced by the
-// planes N·(X − A) = h parallel to the triangle; in each slice the quadric
-// is a conic, and the piece is its arc on the third vertex's side of the
-// glue plane G, between the two points where the slice's line in G meets
-// the conic (at h = 0: the shared vertices A, B). The slices run down to
-// the depth where those two points merge (the bottom of the glue curve).
-struct Slicer {
-  std::size_t triangle;
-  const Quadric* f;
-  Point3 a;
-  Point3 n;   // slicing normal (oriented triangle normal)
-  Point3 nu;  // glue plane normal
-  Point3 l;   // along the slice's line in G
-  Point3 k;   // in the slice, ⟂ l, towards the third vertex
-  double depth;
-};
+namespace {
 
 // The working state of BuildQuadricMesh, filled in by its stages in order.
 struct QuadricBuild {
@@ -213,8 +198,10 @@ struct QuadricBuild {
   const std::string& origin;
   QuadricResult result;
   std::vector<PieceMap> maps;
-  std::vector<Slicer> slicers;
-  std::vector<bool> drawn;  // per triangle: whether it has a slicer yet
+  /// Per triangle and edge k (vertex k to k + 1): the neighbour across it
+  /// (−1 on the boundary) and its glue (index into result.glues, or −1).
+  std::vector<std::array<int, 3>> neighbour;
+  std::vector<std::array<int, 3>> glue_of;
 };
 
 // Narrows [lo, hi] around a minimum of f by golden sections.
@@ -231,6 +218,7 @@ void GoldenSection(const F& f, int iterations, double* lo, double* hi) {
   }
 }
 
+
 void ValidateMesh(const QuadricMesh& mesh) {
   if (mesh.normals.size() != mesh.vertices.size()) {
     throw ConstructionError("there are " + std::to_string(mesh.vertices.size()) + " vertices but " +
@@ -244,6 +232,13 @@ void ValidateMesh(const QuadricMesh& mesh) {
   if (mesh.triangles.empty()) throw ConstructionError("there are no triangles");
   if (!mesh.free.empty() && mesh.free.size() != mesh.triangles.size()) {
     throw ConstructionError("\"free\" needs one list per triangle");
+  }
+  if (mesh.mu.size() > 1 && mesh.mu.size() != mesh.triangles.size()) {
+    throw ConstructionError("\"mu\" needs one value, or one per triangle (" +
+                            std::to_string(mesh.triangles.size()) + ")");
+  }
+  if (mesh.sections < 0 || mesh.sections > 1000) {
+    throw ConstructionError("\"sections\" must be between 0 and 1000");
   }
 }
 
@@ -276,6 +271,7 @@ std::string PieceNote(const std::string& origin, const std::string& name, const 
               " = " + FormatNumber(piece.parameters[k]);
     }
   }
+  note += "; mu = " + FormatNumber(piece.mu);
   const auto& m = piece.quadric.m;
   note += "; F = " + FormatNumber(m[0][0]) + "·dx² + " + FormatNumber(m[1][1]) + "·dy² + " +
           FormatNumber(m[2][2]) + "·dz² + " + FormatNumber(2 * m[0][1]) + "·dx·dy + " +
@@ -285,9 +281,31 @@ std::string PieceNote(const std::string& origin, const std::string& name, const 
   return note;
 }
 
-// Stage 1: every triangle's quadric, with the free parameters chosen.
+
+// μ from the normals: |A₁| times the mean over the edges of the normal
+// curvature (g_i − g_j)·(P_i − P_j)/|P_i − P_j|², 1/r on a sphere of radius r.
+double MuFromNormals(const std::array<Point3, 3>& p, const std::array<Point3, 3>& n) {
+  double sum = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Point3 d = Sub(p[(k + 1) % 3], p[k]);
+    sum += Dot(Sub(Unit(n[(k + 1) % 3]), Unit(n[k])), d) / Dot(d, d);
+  }
+  return Norm(n[0]) * sum / 3;
+}
+
+// Replaces the L² part of F: M ← M + (μ − nᵀMn)·nnᵀ (F and F + c·L² meet
+// the same conditions, so this stays a solution).
+void SetMu(double mu, const Point3& n, Quadric* f) {
+  const double current = f->Form(n, n);
+  for (int j = 0; j < 3; ++j) {
+    for (int k = 0; k < 3; ++k) f->m[j][k] += (mu - current) * n[j] * n[k];
+  }
+}
+
+// Stage 1: every triangle's quadric, with the free parameters or μ chosen.
 void SolvePieces(QuadricBuild& b) {
   const QuadricMesh& mesh = b.mesh;
+  const bool mu_given = !mesh.mu.empty() || mesh.mu_from_normals;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& tri = mesh.triangles[t];
     const std::string name = "triangles[" + std::to_string(t) + "]";
@@ -308,8 +326,19 @@ void SolvePieces(QuadricBuild& b) {
                               " free parameter(s), but \"free\" gives " +
                               std::to_string(mesh.free[t].size()));
     }
+    if (mu_given && !mesh.free.empty() && free_count == 1) {
+      throw ConstructionError(name + ": give either \"free\" or \"mu\": both choose the one free "
+                                     "parameter");
+    }
     piece.parameters = mesh.free.empty() ? std::vector<double>(free_count, 0.0) : mesh.free[t];
     piece.quadric = piece.solution.With(piece.parameters);
+    piece.plane_normal = Unit(Cross(Sub(p[1], p[0]), Sub(p[2], p[0])));
+    if (mu_given) {
+      const double mu = mesh.mu_from_normals ? MuFromNormals(p, n)
+                                             : mesh.mu[mesh.mu.size() == 1 ? 0 : t];
+      SetMu(mu, piece.plane_normal, &piece.quadric);
+    }
+    piece.mu = piece.quadric.Form(piece.plane_normal, piece.plane_normal);
     b.result.notes.push_back(PieceNote(b.origin, name, piece, n[0], tri[0]));
     b.result.pieces.push_back(piece);
   }
@@ -394,21 +423,35 @@ struct EdgePair {
   }
 };
 
-// The angle θ of the glue plane: among the roots of the residual, the one
-// nearest the reference plane through the edge along the mean oriented
-// normal of the two triangles, i.e. "between" them; the triangles' own
-// planes are excluded (both conics lie in them only when the pieces are flat
-// there). Without a root, the reference itself, and *found is false.
-double FindGlueAngle(const EdgePair& pair, const Point3& n1, const Point3& n2, bool* found) {
+
+// The angle θ of the glue plane: the reference plane through the edge along
+// `along`, the mean of the given normals at its ends (or, where that lies
+// along the edge, the mean oriented normal of the two triangles), when both
+// pieces cut the same conic there (always when they are the same quadric, as on a sphere);
+// else, among the roots of the residual, the one nearest the reference,
+// i.e. "between" them. The triangles' own planes are excluded (both conics
+// lie in them only when the pieces are flat there). Without a root, the
+// reference itself, and *found is false.
+double FindGlueAngle(const EdgePair& pair, const Point3& along, const Point3& n1, const Point3& n2,
+                     bool* found) {
   const Point3& e = pair.e;
-  Point3 reference = Sub(Add(n1, n2), Scale(e, Dot(Add(n1, n2), e)));
+  Point3 reference = Sub(along, Scale(e, Dot(along, e)));
+  if (Norm(reference) < 1e-9 * Norm(along)) {
+    reference = Sub(Add(n1, n2), Scale(e, Dot(Add(n1, n2), e)));
+  }
   if (Norm(reference) < 1e-9) reference = Cross(e, n1);
   reference = Unit(reference);
-  constexpr int kScan = 3600;
-  double best_theta = std::atan2(Dot(reference, pair.w), Dot(reference, pair.u));
-  *found = false;
-  double best_score = -1;
+  const auto own_plane = [&](double theta) {
+    const Point3 plane_normal = Cross(e, pair.Direction(theta));
+    return LineAngle(plane_normal, n1) < 1 || LineAngle(plane_normal, n2) < 1;
+  };
+  const double reference_theta = std::atan2(Dot(reference, pair.w), Dot(reference, pair.u));
   const auto residual = [&](double theta) { return pair.Residual(theta); };
+  *found = residual(reference_theta) <= 1e-12 && !own_plane(reference_theta);
+  if (*found) return reference_theta;
+  constexpr int kScan = 3600;
+  double best_theta = reference_theta;
+  double best_score = -1;
   std::vector<double> values(kScan);
   for (int i = 0; i < kScan; ++i) values[i] = residual(std::numbers::pi * i / kScan);
   for (int i = 0; i < kScan; ++i) {
@@ -420,12 +463,8 @@ double FindGlueAngle(const EdgePair& pair, const Point3& n1, const Point3& n2, b
     double hi = std::numbers::pi * (i + 1) / kScan;
     GoldenSection(residual, 80, &lo, &hi);
     const double theta = (lo + hi) / 2;
-    if (residual(theta) > 1e-7) continue;
-    const Point3 p = pair.Direction(theta);
-    const Point3 plane_normal = Cross(e, p);
-    // Not a triangle's own plane.
-    if (LineAngle(plane_normal, n1) < 1 || LineAngle(plane_normal, n2) < 1) continue;
-    const double score = std::fabs(Dot(p, reference));
+    if (residual(theta) > 1e-7 || own_plane(theta)) continue;
+    const double score = std::fabs(Dot(pair.Direction(theta), reference));
     if (score > best_score) {
       best_score = score;
       best_theta = theta;
@@ -435,328 +474,154 @@ double FindGlueAngle(const EdgePair& pair, const Point3& n1, const Point3& n2, b
   return best_theta;
 }
 
-// Stage 3: the edges shared by two triangles, and for each the glue plane.
+std::string EdgeName(int va, int vb) {
+  return "the edge between vertices " + std::to_string(va) + " and " + std::to_string(vb);
+}
+
+// Stage 3: the mesh's edges (each in at most two triangles, run in opposite
+// directions by them), and for each shared edge the glue plane.
 void FindGlues(QuadricBuild& b) {
   const QuadricMesh& mesh = b.mesh;
-  std::map<std::pair<int, int>, std::vector<std::pair<std::size_t, int>>> edges;
+  // (lower vertex, higher vertex) -> (triangle, edge k) of its users.
+  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> edges;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      int va = mesh.triangles[t][(k + 1) % 3];
-      int vb = mesh.triangles[t][(k + 2) % 3];
-      if (va > vb) std::swap(va, vb);
-      edges[{va, vb}].emplace_back(t, k);
+      const int va = mesh.triangles[t][k];
+      const int vb = mesh.triangles[t][(k + 1) % 3];
+      edges[{std::min(va, vb), std::max(va, vb)}].emplace_back(static_cast<int>(t), k);
     }
   }
+  b.neighbour.assign(mesh.triangles.size(), {-1, -1, -1});
+  b.glue_of.assign(mesh.triangles.size(), {-1, -1, -1});
   for (const auto& [key, users] : edges) {
     if (users.size() > 2) {
-      throw ConstructionError("the edge between vertices " + std::to_string(key.first) + " and " +
-                              std::to_string(key.second) + " has " + std::to_string(users.size()) +
-                              " triangles (at most 2)");
+      throw ConstructionError(EdgeName(key.first, key.second) + " belongs to " +
+                              std::to_string(users.size()) +
+                              " triangles (at most 2: the mesh is not a manifold)");
     }
     if (users.size() < 2) continue;
-    const std::size_t t1 = users[0].first;
-    const std::size_t t2 = users[1].first;
+    const auto [t1, k1] = users[0];
+    const auto [t2, k2] = users[1];
+    if (mesh.triangles[t1][k1] == mesh.triangles[t2][k2]) {
+      throw ConstructionError(EdgeName(key.first, key.second) + ": triangles " +
+                              std::to_string(t1) + " and " + std::to_string(t2) +
+                              " run along it in the same direction (inconsistent orientation)");
+    }
+    b.neighbour[t1][k1] = t2;
+    b.neighbour[t2][k2] = t1;
     const EdgePair pair(b.result.pieces[t1].quadric, b.result.pieces[t2].quadric,
                         mesh.vertices[key.first], mesh.vertices[key.second]);
     bool found = false;
-    const double theta = FindGlueAngle(pair, OrientedTriangleNormal(b.maps[t1]),
+    const Point3 along = Add(Unit(mesh.normals[key.first]), Unit(mesh.normals[key.second]));
+    const double theta = FindGlueAngle(pair, along, OrientedTriangleNormal(b.maps[t1]),
                                        OrientedTriangleNormal(b.maps[t2]), &found);
     QuadricGlue glue;
-    glue.triangle_a = static_cast<int>(t1);
-    glue.triangle_b = static_cast<int>(t2);
+    glue.triangle_a = std::min(t1, t2);
+    glue.triangle_b = std::max(t1, t2);
     glue.vertex_a = key.first;
     glue.vertex_b = key.second;
     glue.plane_normal = Unit(Cross(pair.e, pair.Direction(theta)));
     glue.conics_coincide = found;
+    b.glue_of[t1][k1] = b.glue_of[t2][k2] = static_cast<int>(b.result.glues.size());
     b.result.glues.push_back(glue);
   }
 }
 
-// The two points where the slice at depth h meets G and the quadric: their
-// midpoint and half their distance (false where the slice misses).
-bool SliceEnds(const Slicer& sl, double h, Point3* mid, double* half) {
-  const Point3 origin_h = Add(sl.a, Scale(sl.n, h));
-  const double v0 = -h * Dot(sl.nu, sl.n) / Dot(sl.nu, sl.k);
-  const Point3 y = Add(origin_h, Scale(sl.k, v0));
-  const double c2 = sl.f->Form(sl.l, sl.l);
-  const double c1 = Dot(sl.f->Gradient(y), sl.l);
-  const double c0 = sl.f->Value(y);
-  if (std::fabs(c2) < 1e-300) return false;
-  const double disc = c1 * c1 - 4 * c2 * c0;
-  if (disc < 0) return false;
-  const double centre = -c1 / (2 * c2);
-  *half = std::sqrt(disc) / (2 * std::fabs(c2));
-  *mid = Add(y, Scale(sl.l, centre));
-  return true;
-}
-
-// The depth where the end points merge: where the slice's line in G stops
-// meeting the quadric (bisect), or touches it (the half distance has a
-// minimum at 0: golden section). -1 where neither happens within 16 edge
-// lengths.
-double GlueCurveBottom(const Slicer& sl, double size) {
-  const double step = size / 64;
-  constexpr int kSteps = 64 * 16;
-  Point3 mid{};
-  double half = 0;
-  const auto half_at = [&](double h) { return SliceEnds(sl, h, &mid, &half) ? half : -1.0; };
-  double previous = half_at(0);
-  double depth = -1;
-  for (int i = 1; i <= kSteps && depth < 0; ++i) {
-    const double h = step * i;
-    const double current = half_at(h);
-    if (current < 0) {
-      double lo = step * (i - 1);
-      double hi = h;
-      for (int it = 0; it < 100; ++it) {
-        const double m = (lo + hi) / 2;
-        (half_at(m) >= 0 ? lo : hi) = m;
-      }
-      depth = lo;
-    } else if (i >= 2 && previous <= current && previous < 0.25 * size) {
-      double lo = step * (i - 2);
-      double hi = h;
-      GoldenSection(half_at, 200, &lo, &hi);
-      if (half_at((lo + hi) / 2) <= 1e-6 * size) depth = (lo + hi) / 2;
-    }
-    previous = current;
-  }
-  return depth;
-}
-
-// Sets up the slicer of triangle t hanging from its edge va–vb, cut off by
-// the glue plane with the given normal.
-void AddSlicer(QuadricBuild& b, std::size_t t, int va, int vb, const Point3& plane_normal) {
+// Stage 4: each piece's three trimming planes: the glue plane of a shared
+// edge; on the boundary the plane through the edge along the triangle's
+// normal (the piece's normals can lie in the triangle's plane, as in the
+// seed's example). Oriented towards the third vertex.
+void SetUpPlanes(QuadricBuild& b) {
   const QuadricMesh& mesh = b.mesh;
-  const Point3 a = mesh.vertices[va];
-  Point3 c{};
-  for (int k = 0; k < 3; ++k) {
-    const int v = mesh.triangles[t][k];
-    if (v != va && v != vb) c = mesh.vertices[v];
-  }
-  Slicer sl{
-      t, &b.result.pieces[t].quadric, a, OrientedTriangleNormal(b.maps[t]), plane_normal, {}, {},
-      0};
-  sl.l = Unit(Cross(sl.n, sl.nu));
-  sl.k = Unit(Cross(sl.n, sl.l));
-  if (Dot(sl.k, Sub(c, a)) < 0) sl.k = Scale(sl.k, -1);
-  const double size = Norm(Sub(mesh.vertices[vb], a));
-  double depth = GlueCurveBottom(sl, size);
-  if (depth < 0) {
-    depth = 2 * size;
-    b.result.notes.push_back(
-        b.origin + ": triangles[" + std::to_string(t) +
-        "]: the piece does not close below its triangle (the glue curve is unbounded); "
-        "drawn down to depth " +
-        FormatNumber(depth));
-  }
-  sl.depth = depth;
-  b.slicers.push_back(sl);
-  b.drawn[t] = true;
-}
-
-// Stage 4: a slicer per piece, from its first glued edge, or from its first
-// edge along its normal where it has no neighbour.
-void SetUpSlicers(QuadricBuild& b) {
-  const QuadricMesh& mesh = b.mesh;
-  b.drawn.assign(mesh.triangles.size(), false);
-  for (const QuadricGlue& glue : b.result.glues) {
-    for (int t : {glue.triangle_a, glue.triangle_b}) {
-      if (b.drawn[t]) {
-        b.result.notes.push_back(b.origin + ": triangles[" + std::to_string(t) +
-                                 "] has more than one glued edge; it is drawn from its first only");
-        continue;
-      }
-      AddSlicer(b, t, glue.vertex_a, glue.vertex_b, glue.plane_normal);
-    }
-  }
+  b.result.planes.resize(mesh.triangles.size());
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (b.drawn[t]) continue;
-    // No neighbour: the plane through the first edge along the normal.
-    const Point3 a = mesh.vertices[mesh.triangles[t][0]];
-    const Point3 c = mesh.vertices[mesh.triangles[t][1]];
-    AddSlicer(b, t, mesh.triangles[t][0], mesh.triangles[t][1],
-              Unit(Cross(Sub(c, a), OrientedTriangleNormal(b.maps[t]))));
+    const PieceMap& map = b.maps[t];
+    for (int k = 0; k < 3; ++k) {
+      const Point3& a = map.p[k];
+      const Point3& c = map.p[(k + 2) % 3];
+      const Point3 e = Unit(Sub(map.p[(k + 1) % 3], a));
+      Point3 normal{};
+      if (b.glue_of[t][k] >= 0) {
+        normal = b.result.glues[b.glue_of[t][k]].plane_normal;
+      } else {
+        normal = Unit(Cross(e, OrientedTriangleNormal(map)));
+      }
+      Plane plane = Plane::Through(a, normal);
+      const double side = plane.Side(c);
+      const double size = Norm(Sub(c, a)) + Norm(Sub(map.p[(k + 1) % 3], a));
+      if (std::fabs(side) <= 1e-9 * size) {
+        throw ConstructionError("triangles[" + std::to_string(t) + "]: the trimming plane of " +
+                                EdgeName(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3]) +
+                                " passes through the triangle's third vertex");
+      }
+      if (side < 0) plane = Plane::Through(a, Scale(normal, -1));
+      b.result.planes[t][k] = plane;
+    }
   }
 }
 
-// An ellipse is walked by its own angle from E2 to E1 through the k side
-// (smooth in h and φ). False where the slice's conic is not an ellipse.
-bool EllipsePoint(const Slicer& sl, const Point3& mid, double half, double phi, Point3* out) {
-  const Point3 y = mid;
-  const double qa = sl.f->Form(sl.l, sl.l);
-  const double qb = sl.f->Form(sl.l, sl.k);
-  const double qc = sl.f->Form(sl.k, sl.k);
-  const Point3 grad = sl.f->Gradient(y);
-  const double gd = Dot(grad, sl.l);
-  const double ge = Dot(grad, sl.k);
-  const double det = qa * qc - qb * qb;
-  if (!(det > 1e-12 * (qa * qa + qc * qc))) return false;
-  const double cu = -(qc * gd - qb * ge) / (2 * det);
-  const double cv = -(qa * ge - qb * gd) / (2 * det);
-  const double fc = sl.f->Value(Add(y, Add(Scale(sl.l, cu), Scale(sl.k, cv))));
-  // Eigen-decomposition of [[qa, qb], [qb, qc]].
-  const double angle = 0.5 * std::atan2(2 * qb, qa - qc);
-  const double c = std::cos(angle);
-  const double sn = std::sin(angle);
-  const double l1 = qa * c * c + 2 * qb * c * sn + qc * sn * sn;
-  const double l2 = qa * sn * sn - 2 * qb * c * sn + qc * c * c;
-  if (!(-fc / l1 > 0 && -fc / l2 > 0)) return false;
-  const double r1 = std::sqrt(-fc / l1);
-  const double r2 = std::sqrt(-fc / l2);
-  // (u, v) = centre + r1·cosψ·(c, sn) + r2·sinψ·(−sn, c).
-  const auto to_angle = [&](double u, double v) {
-    const double du = u - cu;
-    const double dv = v - cv;
-    return std::atan2((-sn * du + c * dv) / r2, (c * du + sn * dv) / r1);
-  };
-  const double start = to_angle(half, 0);    // E2
-  double span = to_angle(-half, 0) - start;  // to E1
-  const auto v_at = [&](double psi) {
-    return cv + r1 * std::cos(psi) * sn + r2 * std::sin(psi) * c;
-  };
-  if (span <= 0) span += 2 * std::numbers::pi;
-  if (v_at(start + span / 2) < 0) span -= 2 * std::numbers::pi;
-  const double psi = start + span * phi / std::numbers::pi;
-  const double u = cu + r1 * std::cos(psi) * c - r2 * std::sin(psi) * sn;
-  *out = Add(y, Add(Scale(sl.l, u), Scale(sl.k, v_at(psi))));
-  return true;
-}
-
-// Other conics: the ray from the chord's midpoint at angle φ, to its nearest
-// crossing with the quadric.
-bool RayPoint(const Slicer& sl, const Point3& mid, double phi, Point3* out) {
-  const Point3 w = Add(Scale(sl.l, std::cos(phi)), Scale(sl.k, std::sin(phi)));
-  const double c2 = sl.f->Form(w, w);
-  const double c1 = Dot(sl.f->Gradient(mid), w);
-  const double c0 = sl.f->Value(mid);
-  double r = -1;
-  if (std::fabs(c2) <= 1e-14 * (std::fabs(c1) + std::fabs(c0) + 1e-300)) {
-    if (c1 != 0) r = -c0 / c1;
-  } else {
-    const double disc = c1 * c1 - 4 * c2 * c0;
-    if (disc < 0) return false;
-    const double q = -(c1 + std::copysign(std::sqrt(disc), c1)) / 2;
-    const double r1 = q / c2;
-    const double r2 = q != 0 ? c0 / q : r1;
-    r = std::min(r1 > 0 ? r1 : 1e300, r2 > 0 ? r2 : 1e300);
-    if (r >= 1e300) r = -1;
-  }
-  if (r < 0) return false;
-  *out = Add(mid, Scale(w, r));
-  return true;
-}
-
-// The point of slice h at angle φ ∈ [0, π] from the end point E2.
-bool SlicePoint(const Slicer& sl, double h, double phi, Point3* out) {
-  Point3 mid{};
-  double half = 0;
-  if (!SliceEnds(sl, h, &mid, &half)) {
-    // At the bottom the two ends merge into one point.
-    if (!SliceEnds(sl, sl.depth, &mid, &half)) return false;
-    *out = mid;
-    return true;
-  }
-  if (phi <= 0 || phi >= std::numbers::pi) {
-    *out = Add(mid, Scale(sl.l, phi <= 0 ? half : -half));
-    return true;
-  }
-  if (EllipsePoint(sl, mid, half, phi, out)) return true;
-  return RayPoint(sl, mid, phi, out);
-}
-
-// h_i = depth·(1 − (1 − i/n)²): finer towards the bottom, where the arcs
-// shrink like the square root of the remaining depth.
-double DepthAt(const Slicer& sl, double x) { return sl.depth * (1 - (1 - x) * (1 - x)); }
-
-Point3 BilinearAt(const std::array<Point3, 4>& c, double x, double y) {
-  return Add(Add(Scale(c[0], (1 - x) * (1 - y)), Scale(c[1], x * (1 - y))),
-             Add(Scale(c[2], (1 - x) * y), Scale(c[3], x * y)));
-}
-
-// One tessellation attempt's output over all pieces.
-struct Tessellation {
-  std::vector<Patch> patches;
-  int missing = 0;
-  double worst = 0;
-};
-
-// Cuts one piece into n×n bilinear cells, measuring each at its centre and
-// edge midpoints; cells with a corner or probe off the surface are counted
-// as missing.
-void TessellatePiece(const Slicer& sl, int n, const std::string& origin, Tessellation* out) {
-  const auto at = [&](double i, double j, Point3* point) {
-    return SlicePoint(sl, DepthAt(sl, i / n), std::numbers::pi * j / n, point);
-  };
-  std::vector<std::vector<Point3>> grid(n + 1, std::vector<Point3>(n + 1));
-  std::vector<std::vector<bool>> ok(n + 1, std::vector<bool>(n + 1));
-  for (int i = 0; i <= n; ++i) {
-    for (int j = 0; j <= n; ++j) ok[i][j] = at(i, j, &grid[i][j]);
-  }
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      bool covered = ok[i][j] && ok[i + 1][j] && ok[i][j + 1] && ok[i + 1][j + 1];
-      const std::array<Point3, 4> c = {grid[i][j], grid[i + 1][j], grid[i][j + 1],
-                                       grid[i + 1][j + 1]};
-      static const double kProbe[5][2] = {{0.5, 0.5}, {0.5, 0}, {0.5, 1}, {0, 0.5}, {1, 0.5}};
-      double deviation = 0;
-      for (const auto& probe : kProbe) {
-        Point3 exact{};
-        if (!covered || !at(i + probe[0], j + probe[1], &exact)) {
-          covered = false;
-          break;
+// Stage 5: every piece drawn; a shared edge's outline goes to the drawing
+// once, from the lower-numbered triangle.
+void DrawPieces(QuadricBuild& b) {
+  const QuadricMesh& mesh = b.mesh;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    internal::PieceInput in;
+    in.f = &b.result.pieces[t].quadric;
+    in.triangle = static_cast<int>(t);
+    in.p = b.maps[t].p;
+    in.planes = b.result.planes[t];
+    in.n = b.result.pieces[t].plane_normal;
+    in.sections = mesh.sections;
+    in.tolerance = b.tolerance;
+    std::vector<QuadricArc> arcs;
+    try {
+      arcs = internal::DrawPiece(in);
+    } catch (const ConstructionError& e) {
+      throw ConstructionError(std::string("triangles[") + std::to_string(t) + "]: " + e.what());
+    }
+    for (QuadricArc& arc : arcs) {
+      const int other = arc.role == QuadricArc::Role::kOutline ? b.neighbour[t][arc.index] : -1;
+      arc.drawn = other < 0 || other > static_cast<int>(t);
+      b.result.bound = std::max(b.result.bound, arc.bound);
+      if (arc.drawn) {
+        const std::string what =
+            arc.role == QuadricArc::Role::kOutline
+                ? " outline " + std::to_string(mesh.triangles[t][arc.index]) + "-" +
+                      std::to_string(mesh.triangles[t][(arc.index + 1) % 3])
+                : " section " + std::to_string(arc.index);
+        for (const CubicArc& cubic : arc.cubics) {
+          Curve curve;
+          curve.basis = Basis::kBezier;
+          curve.g = cubic.b;
+          curve.origin = b.origin + " triangle " + std::to_string(t) + what;
+          b.result.curves.push_back(curve);
         }
-        deviation = std::max(deviation, Norm(Sub(exact, BilinearAt(c, probe[0], probe[1]))));
       }
-      if (!covered) {
-        ++out->missing;
-        continue;
-      }
-      out->worst = std::max(out->worst, deviation);
-      Patch patch = BezierPatchOf(BilinearSurface(c[0], c[1], c[2], c[3]));
-      patch.origin = origin + " triangle " + std::to_string(sl.triangle) + " cell (" +
-                     std::to_string(i) + "," + std::to_string(j) + ")";
-      out->patches.push_back(patch);
+      b.result.arcs.push_back(std::move(arc));
     }
   }
 }
 
-// Stage 5: doubles the cells per side until every piece is within tolerance.
-void Tessellate(QuadricBuild& b) {
-  constexpr int kMaxCells = 256;
-  for (int n = 2;; n *= 2) {
-    if (n > kMaxCells) {
-      throw ConstructionError("the tessellation needs more than " + std::to_string(kMaxCells) +
-                              "x" + std::to_string(kMaxCells) + " cells per piece for tolerance " +
-                              FormatNumber(b.tolerance));
-    }
-    Tessellation attempt;
-    for (const Slicer& sl : b.slicers) TessellatePiece(sl, n, b.origin, &attempt);
-    if (attempt.worst <= b.tolerance) {
-      b.result.patches = std::move(attempt.patches);
-      b.result.cells_per_side = n;
-      b.result.missing_cells = attempt.missing;
-      b.result.tessellation_error = attempt.worst;
-      break;
-    }
-  }
-  if (b.result.patches.empty()) throw ConstructionError("no piece could be drawn");
-}
-
-// Along the glue curve (the end points of piece a's slices), piece b's
-// distance (to first order) and the angle between the normals.
+// Along piece a's outline on the glue's edge, piece b's distance (to first
+// order) and the angle between the normals.
 void MeasureGlue(const QuadricBuild& b, QuadricGlue& glue) {
-  const Slicer* sl = nullptr;
-  for (const Slicer& s : b.slicers) {
-    if (s.triangle == static_cast<std::size_t>(glue.triangle_a)) sl = &s;
-  }
   const Quadric& fa = b.result.pieces[glue.triangle_a].quadric;
   const Quadric& fb = b.result.pieces[glue.triangle_b].quadric;
+  int edge = -1;
+  for (int k = 0; k < 3; ++k) {
+    if (b.glue_of[glue.triangle_a][k] >= 0 &&
+        &b.result.glues[b.glue_of[glue.triangle_a][k]] == &glue) {
+      edge = k;
+    }
+  }
   double gap = 0;
-  for (int i = 0; sl != nullptr && i <= 256; ++i) {
-    for (double phi : {0.0, std::numbers::pi}) {
-      Point3 x{};
-      if (!SlicePoint(*sl, DepthAt(*sl, i / 256.0), phi, &x)) continue;
+  for (const QuadricArc& arc : b.result.arcs) {
+    if (arc.triangle != glue.triangle_a || arc.role != QuadricArc::Role::kOutline ||
+        arc.index != edge) {
+      continue;
+    }
+    for (int i = 0; i <= 64; ++i) {
+      const Point3 x = arc.arc.At(i / 64.0);
       const Point3 gb = fb.Gradient(x);
       gap = std::max(gap, std::fabs(fb.Value(x)) / Norm(gb));
       glue.worst_normal_angle_deg =
@@ -785,6 +650,7 @@ std::string GlueNote(const std::string& origin, const QuadricGlue& glue) {
   return note;
 }
 
+
 // Stage 6: how well each glued pair joins (C0 or G1), and the summary note.
 void ReportJoins(QuadricBuild& b) {
   QuadricResult& result = b.result;
@@ -792,28 +658,194 @@ void ReportJoins(QuadricBuild& b) {
     MeasureGlue(b, glue);
     result.notes.push_back(GlueNote(b.origin, glue));
   }
-  result.notes.push_back(b.origin + ": tessellated into " + std::to_string(result.patches.size()) +
-                         " bilinear patches (" + std::to_string(result.cells_per_side) + "x" +
-                         std::to_string(result.cells_per_side) + " cells per piece" +
-                         (result.missing_cells > 0
-                              ? ", " + std::to_string(result.missing_cells) +
-                                    " cells left out where a slice misses the surface"
-                              : std::string()) +
-                         "), largest sampled deviation " + FormatNumber(result.tessellation_error) +
-                         " (tolerance " + FormatNumber(b.tolerance) + ")");
+  std::size_t outlines = 0;
+  std::size_t sections = 0;
+  for (const QuadricArc& arc : result.arcs) {
+    if (!arc.drawn) continue;
+    (arc.role == QuadricArc::Role::kOutline ? outlines : sections) += 1;
+  }
+  result.notes.push_back(b.origin + ": " + std::to_string(result.pieces.size()) +
+                         " pieces drawn as " + std::to_string(result.curves.size()) +
+                         " cubic curves (" + std::to_string(outlines) + " outline and " +
+                         std::to_string(sections) +
+                         " section conic arcs); every point within " +
+                         FormatNumber(result.bound) + " of its quadric piece, proven (tolerance " +
+                         FormatNumber(b.tolerance) + ")");
 }
 
 }  // namespace
 
-QuadricResult BuildQuadricMesh(const QuadricMesh& mesh, double tolerance,
+namespace {
+
+// The seed's conditions on one triangle (i, j, k) have a solution only when
+// C = (A_i·e_ij)(A_j·e_jk)(A_k·e_ki) + (A_j·e_ij)(A_k·e_jk)(A_i·e_ki) = 0:
+// for a quadric F(P_j) − F(P_i) = ½(∇F(P_i) + ∇F(P_j))·e_ij exactly, so
+// λ_i·A_i·e_ij + λ_j·A_j·e_ij = 0 on each edge, three equations for the two
+// free λ. Returns C over |e_ij|·|e_jk|·|e_ki| (a product of three cosines)
+// and its gradient in the three normals; *terms gets |first| + |second| on
+// the same scale.
+double Compatibility(const std::array<Point3, 3>& p, const std::array<Point3, 3>& a,
+                     std::array<Point3, 3>* gradient, double* terms) {
+  std::array<Point3, 3> e{};  // e[k] = p[k+1] − p[k]
+  for (int k = 0; k < 3; ++k) e[k] = Sub(p[(k + 1) % 3], p[k]);
+  // out[k] = A_k·e_k (along its edge forward), in[k] = A_k·e_(k−1) (the
+  // edge arriving at it).
+  double out[3];
+  double in[3];
+  for (int k = 0; k < 3; ++k) {
+    out[k] = Dot(a[k], e[k]);
+    in[k] = Dot(a[k], e[(k + 2) % 3]);
+  }
+  const double scale = Norm(e[0]) * Norm(e[1]) * Norm(e[2]);
+  const double first = out[0] * out[1] * out[2];
+  const double second = in[1] * in[2] * in[0];
+  for (int k = 0; k < 3; ++k) {
+    const int k1 = (k + 1) % 3;
+    const int k2 = (k + 2) % 3;
+    (*gradient)[k] =
+        Scale(Add(Scale(e[k], out[k1] * out[k2]), Scale(e[k2], in[k1] * in[k2])), 1 / scale);
+  }
+  *terms = (std::fabs(first) + std::fabs(second)) / scale;
+  return (first + second) / scale;
+}
+
+// Conjugate gradients on J·Jᵀ·y = b, J given by its rows (9 entries each:
+// the tangent-plane derivatives for the triangle's 3 vertices).
+struct SparseRows {
+  std::vector<std::array<int, 3>> vertex;
+  std::vector<std::array<double, 6>> value;  // per vertex (d/dt1, d/dt2)
+};
+
+std::vector<double> SolveNormalEquations(const SparseRows& j, std::size_t vertices,
+                                         const std::vector<double>& b) {
+  const std::size_t n = b.size();
+  const auto apply = [&](const std::vector<double>& y) {
+    std::vector<double> x(2 * vertices, 0.0);  // Jᵀ·y
+    for (std::size_t r = 0; r < n; ++r) {
+      for (int k = 0; k < 3; ++k) {
+        x[2 * j.vertex[r][k]] += j.value[r][2 * k] * y[r];
+        x[2 * j.vertex[r][k] + 1] += j.value[r][2 * k + 1] * y[r];
+      }
+    }
+    std::vector<double> out(n, 0.0);  // J·x
+    for (std::size_t r = 0; r < n; ++r) {
+      for (int k = 0; k < 3; ++k) {
+        out[r] += j.value[r][2 * k] * x[2 * j.vertex[r][k]] +
+                  j.value[r][2 * k + 1] * x[2 * j.vertex[r][k] + 1];
+      }
+      out[r] += 1e-14 * y[r];  // a whisper of damping for rank-deficient J
+    }
+    return out;
+  };
+  std::vector<double> y(n, 0.0);
+  std::vector<double> r = b;
+  std::vector<double> d = r;
+  double rr = 0;
+  for (double v : r) rr += v * v;
+  const double target = 1e-28 * std::max(rr, 1e-300);
+  for (std::size_t it = 0; it < 4 * n + 20 && rr > target; ++it) {
+    const std::vector<double> ad = apply(d);
+    double dad = 0;
+    for (std::size_t i = 0; i < n; ++i) dad += d[i] * ad[i];
+    if (!(dad > 0)) break;
+    const double alpha = rr / dad;
+    double next = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      y[i] += alpha * d[i];
+      r[i] -= alpha * ad[i];
+      next += r[i] * r[i];
+    }
+    for (std::size_t i = 0; i < n; ++i) d[i] = r[i] + (next / rr) * d[i];
+    rr = next;
+  }
+  return y;
+}
+
+// Gauss-Newton on the normals' directions: each step is the least turn (to
+// first order) that zeroes every triangle's C, until each |C| is below
+// 1e-10 of its terms.
+std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double* largest_turn_deg) {
+  std::vector<Point3> a;
+  for (const Point3& n : mesh.normals) a.push_back(Unit(n));
+  constexpr int kSteps = 60;
+  for (int step = 0;; ++step) {
+    // Each normal turns in its tangent plane, spanned by t1, t2.
+    std::vector<std::array<Point3, 2>> tangent(a.size());
+    for (std::size_t v = 0; v < a.size(); ++v) {
+      Point3 t1 = Cross(a[v], std::fabs(a[v][0]) < 0.6 ? Point3{1, 0, 0} : Point3{0, 1, 0});
+      t1 = Unit(t1);
+      tangent[v] = {t1, Cross(a[v], t1)};
+    }
+    SparseRows rows;
+    std::vector<double> rhs;
+    double worst = 0;
+    for (const auto& tri : mesh.triangles) {
+      const std::array<Point3, 3> p = {mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                       mesh.vertices[tri[2]]};
+      std::array<Point3, 3> g{};
+      double terms = 0;
+      const double c = Compatibility(p, {a[tri[0]], a[tri[1]], a[tri[2]]}, &g, &terms);
+      if (std::fabs(c) > 1e-10 * terms) worst = std::max(worst, std::fabs(c) / terms);
+      std::array<double, 6> value{};
+      for (int k = 0; k < 3; ++k) {
+        value[2 * k] = Dot(g[k], tangent[tri[k]][0]);
+        value[2 * k + 1] = Dot(g[k], tangent[tri[k]][1]);
+      }
+      rows.vertex.push_back(tri);
+      rows.value.push_back(value);
+      rhs.push_back(-c);
+    }
+    if (worst == 0) break;
+    if (step == kSteps) {
+      throw ConstructionError("the normals cannot be turned so that every triangle's conditions "
+                              "have a solution (still " + FormatNumber(worst) +
+                              " of the terms off after " + std::to_string(kSteps) + " steps)");
+    }
+    const std::vector<double> y = SolveNormalEquations(rows, a.size(), rhs);
+    std::vector<Point3> delta(a.size(), Point3{0, 0, 0});
+    for (std::size_t r = 0; r < y.size(); ++r) {
+      for (int k = 0; k < 3; ++k) {
+        const int v = rows.vertex[r][k];
+        delta[v] = Add(delta[v], Add(Scale(tangent[v][0], rows.value[r][2 * k] * y[r]),
+                                     Scale(tangent[v][1], rows.value[r][2 * k + 1] * y[r])));
+      }
+    }
+    for (std::size_t v = 0; v < a.size(); ++v) a[v] = Unit(Add(a[v], delta[v]));
+  }
+  *largest_turn_deg = 0;
+  for (std::size_t v = 0; v < a.size(); ++v) {
+    *largest_turn_deg = std::max(*largest_turn_deg, LineAngle(a[v], mesh.normals[v]));
+  }
+  return a;
+}
+
+}  // namespace
+
+QuadricResult BuildQuadricMesh(const QuadricMesh& given, double tolerance,
                                const std::string& origin) {
-  ValidateMesh(mesh);
+  ValidateMesh(given);
+  if (!(tolerance > 0)) throw ConstructionError("the tolerance must be positive");
+  QuadricMesh mesh = given;
+  double turn = 0;
+  if (given.adjust_normals) {
+    for (const auto& tri : given.triangles) {
+      CheckTriangleIndices(given, tri, "a triangle");
+    }
+    mesh.normals = CompatibleNormals(given, &turn);
+  }
   QuadricBuild build{mesh, tolerance, origin, {}, {}, {}, {}};
+  if (given.adjust_normals) {
+    build.result.normals = mesh.normals;
+    build.result.largest_normal_turn_deg = turn;
+    build.result.notes.push_back(
+        origin + ": normals turned by up to " + FormatNumber(turn) +
+        " degrees so that every triangle's conditions have a solution");
+  }
   SolvePieces(build);
   OrientPieces(build);
   FindGlues(build);
-  SetUpSlicers(build);
-  Tessellate(build);
+  SetUpPlanes(build);
+  DrawPieces(build);
   ReportJoins(build);
   return std::move(build.result);
 }

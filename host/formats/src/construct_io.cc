@@ -404,8 +404,24 @@ void AddClosedNet(const json& e, const Place& place, PatchSet* set) {
   }
 }
 
+// "mu": a number (every triangle), an array (one per triangle) or "normals".
+void ParseMu(const json& e, const Place& place, QuadricMesh* mesh) {
+  if (!e.contains("mu")) return;
+  const json& mu = e["mu"];
+  const Place mp = place.Child("mu");
+  if (mu.is_string()) {
+    if (mu.get<std::string>() != "normals") throw mp.Error(R"(must be a number, an array or "normals")");
+    mesh->mu_from_normals = true;
+  } else if (mu.is_number()) {
+    mesh->mu = {mu.get<double>()};
+  } else {
+    mesh->mu = ParseNumbers(mu, mp);
+  }
+}
+
 void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
-  CheckFields(e, place, {"type", "vertices", "normals", "triangles", "free", "tolerance"},
+  CheckFields(e, place,
+              {"type", "vertices", "normals", "triangles", "free", "mu", "sections", "tolerance"},
               {"vertices", "normals", "triangles"});
   QuadricMesh mesh;
   mesh.vertices = ParsePoints(e["vertices"], place.Child("vertices"), 3);
@@ -432,10 +448,17 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
       mesh.free.push_back(ParseNumbers(e["free"][t], fp.Index(t)));
     }
   }
+  ParseMu(e, place, &mesh);
+  if (e.contains("sections")) {
+    if (!e["sections"].is_number_integer()) {
+      throw place.Child("sections").Error("must be a whole number of sections per piece");
+    }
+    mesh.sections = e["sections"].get<int>();
+  }
   const double tolerance = Tolerance(e, place, 1e-3);
   try {
     QuadricResult result = BuildQuadricMesh(mesh, tolerance, SegmentOrigin(place, 0, 1));
-    for (Patch& p : result.patches) set->patches.push_back(std::move(p));
+    for (Curve& c : result.curves) set->curves.push_back(std::move(c));
     for (std::string& note : result.notes) set->notes.push_back(std::move(note));
   } catch (const ConstructionError& error) {
     throw place.Error(error.what());

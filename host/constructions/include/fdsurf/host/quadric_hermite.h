@@ -2,9 +2,10 @@
 // Piecewise quadric Hermite interpolation over a triangulation (seed 000):
 // for each triangle a second-order surface F(x,y,z) = 0 through its three
 // vertices whose normals there are parallel to the given vectors; neighbouring
-// pieces glued along a plane through their two shared vertices. The pieces
-// are implicit, so they are drawn through a double-precision tessellation
-// into bilinear patches (docs/constructions.md, row 12).
+// pieces glued along a plane through their two shared vertices. Each piece is
+// its quadric trimmed by the planes of its three edges, drawn by plane
+// sections (conic arcs, exactly rational quadratic curves) approximated by
+// cubic Bézier curves within a proven bound (docs/constructions.md, row 12).
 #pragma once
 
 #include <array>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "fdsurf/config/nodiscard.h"
+#include "fdsurf/host/conic_arc.h"
 #include "fdsurf/host/patch_set.h"
 
 namespace fdsurf::host {
@@ -27,6 +29,16 @@ struct Quadric {
   FDSURF_NODISCARD Point3 Gradient(const Point3& x) const;
   /// Q(d) = dᵀ·M·d, the quadratic part along a direction.
   FDSURF_NODISCARD double Form(const Point3& d, const Point3& e) const;
+};
+
+/// The points X with Dot(normal, X) = offset; `normal` has unit length.
+/// Side(X) > 0 on the side the normal points to.
+struct Plane {
+  Point3 normal{};
+  double offset = 0;
+  FDSURF_NODISCARD double Side(const Point3& x) const;
+  /// The plane through `point` with the given unit normal.
+  static Plane Through(const Point3& point, const Point3& unit_normal);
 };
 
 /// The names of the unknowns of the linear system, in order:
@@ -57,18 +69,42 @@ struct QuadricSolution {
 QuadricSolution SolveQuadricTriangle(const std::array<Point3, 3>& p,
                                      const std::array<Point3, 3>& n);
 
+/// A triangulation with a normal vector per vertex. Triangles list vertex
+/// indices; a triangle's first vertex is the seed's P₁ (F is written around
+/// it and ∇F(P₁) = 2·A₁, so the length of that normal scales F).
 struct QuadricMesh {
   std::vector<Point3> vertices;
   std::vector<Point3> normals;
   std::vector<std::array<int, 3>> triangles;
   /// Free parameter values per triangle (empty: 0 for every free unknown).
   std::vector<std::vector<double>> free;
+  /// μ, the coefficient of L² in F = F* + μ·L² (L(X) = n·(X − P₁), n the
+  /// triangle's unit normal, F* the member of the family with no L² part:
+  /// nᵀ·M*·n = 0): empty to let `free` decide, one value for every
+  /// triangle, or one per triangle. In units of F per length².
+  std::vector<double> mu;
+  /// μ from the normals instead: per triangle |A₁| times the mean over its
+  /// edges of (g_i − g_j)·(P_i − P_j) / |P_i − P_j|² (g the unit normals),
+  /// the normal curvature the normals turn by. Exact on a sphere.
+  bool mu_from_normals = false;
+  /// Plane sections drawn across each piece, parallel to its triangle.
+  int sections = 8;
+  /// Turn the normals (by as little as it takes) until every triangle's
+  /// conditions have a solution: they do only when
+  /// (A_i·e_ij)(A_j·e_jk)(A_k·e_ki) = −(A_j·e_ij)(A_k·e_jk)(A_i·e_ki)
+  /// (e_ij = P_j − P_i), which normals from a file rarely meet exactly.
+  /// Off: such a triangle is refused.
+  bool adjust_normals = false;
 };
 
 struct QuadricPiece {
   QuadricSolution solution;
   Quadric quadric;
   std::vector<double> parameters;
+  /// nᵀ·M·n of the chosen quadric: its μ.
+  double mu = 0;
+  /// The triangle's unit normal n (the direction of L).
+  Point3 plane_normal{};
 };
 
 struct QuadricGlue {
@@ -88,23 +124,47 @@ struct QuadricGlue {
   double gap = 0;
 };
 
+/// One drawn conic arc of a piece and its cubic approximation.
+struct QuadricArc {
+  enum class Role { kOutline, kSection };
+  int triangle = 0;
+  Role role = Role::kSection;
+  /// Outline: the triangle's edge (k: from its vertex k to vertex k+1 mod 3);
+  /// section: its index (0 .. sections − 1).
+  int index = 0;
+  /// Whether the curves went to the drawing (a shared edge's outline is
+  /// drawn once, from the lower-numbered triangle).
+  bool drawn = true;
+  RationalQuadratic arc;
+  std::vector<CubicArc> cubics;
+  /// Proven: every point of the cubics lies within `bound` of the quadric
+  /// (the cubic's bound plus the arc's own distance from the quadric, which
+  /// is double rounding).
+  double bound = 0;
+};
+
 struct QuadricResult {
   std::vector<QuadricPiece> pieces;
   std::vector<QuadricGlue> glues;
-  /// Bilinear patches of the tessellation, and how many cells had a corner
-  /// where the surface does not meet the sampling line (left out).
-  std::vector<Patch> patches;
-  int cells_per_side = 0;
-  int missing_cells = 0;
-  /// The tessellation tolerance reached: the largest distance, at every
-  /// cell's centre and edge midpoints, between the surface and the patch.
-  double tessellation_error = 0;
+  /// The trimming planes of each piece, oriented so that Side > 0 inside
+  /// (towards the third vertex): planes[t][k] holds edge k of triangle t.
+  std::vector<std::array<Plane, 3>> planes;
+  std::vector<QuadricArc> arcs;
+  /// The cubic Bézier curves of every drawn arc, in order.
+  std::vector<Curve> curves;
+  /// The largest QuadricArc::bound.
+  double bound = 0;
+  /// With adjust_normals: the normals used, and the largest turn (degrees).
+  std::vector<Point3> normals;
+  double largest_normal_turn_deg = 0;
   std::vector<std::string> notes;
 };
 
-/// Solves every triangle, glues neighbours and tessellates each piece into
-/// bilinear patches until the sampled deviation is ≤ `tolerance` (file
-/// units). Throws ConstructionError on bad input.
+/// Solves every triangle, glues neighbours and draws each piece as cubic
+/// curves within `tolerance` (file units) of it. Throws ConstructionError on
+/// bad input: an edge of more than two triangles or two triangles that run
+/// along an edge the same way (naming the edge), and the cases of
+/// SolveQuadricTriangle (naming the triangle).
 QuadricResult BuildQuadricMesh(const QuadricMesh& mesh, double tolerance,
                                const std::string& origin);
 

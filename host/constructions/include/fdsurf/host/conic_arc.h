@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// Conic arcs as rational quadratic Bézier curves, and their approximation by
+// cubic Bézier curves with a proven bound (docs/constructions.md, row 12,
+// "The cubic approximation of a conic arc").
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "fdsurf/config/nodiscard.h"
+#include "fdsurf/host/patch_set.h"
+
+namespace fdsurf::host {
+
+/// r(t) = (B0·p0 + w·B1·p1 + B2·p2) / (B0 + w·B1 + B2), t ∈ [0, 1], B_i the
+/// quadratic Bernstein polynomials. Every bounded arc of a conic is one for
+/// some w > 0 (w < 1 ellipse, w = 1 parabola, w > 1 hyperbola); p1 is where
+/// the tangents at the ends meet. Coordinates in any unit (the file's).
+struct RationalQuadratic {
+  Point3 p0{};
+  Point3 p1{};
+  Point3 p2{};
+  double w = 1;
+  /// The point at t (exact up to double rounding).
+  FDSURF_NODISCARD Point3 At(double t) const;
+};
+
+/// A cubic Bézier curve b and a proven bound: |c(t) − r(t)| ≤ bound for every
+/// t ∈ [0, 1], r the arc it approximates (same t), c the cubic.
+struct CubicArc {
+  std::array<Point3, 4> b{};
+  double bound = 0;
+  /// The (sub-)arc it approximates.
+  RationalQuadratic arc;
+};
+
+/// The two halves of an arc at t = 1/2, each again a rational quadratic
+/// (its weight is sqrt((1 + w) / 2)).
+void SplitArc(const RationalQuadratic& arc, RationalQuadratic* first, RationalQuadratic* second);
+
+/// The cubic Hermite interpolant of the arc: the same end points and end
+/// derivatives in t (r′(0) = 2w·(p1 − p0)), so b1 = p0 + (2w/3)·(p1 − p0),
+/// b2 = p2 + (2w/3)·(p1 − p2); its error falls as the fourth power of the
+/// arc's length. The bound: the largest Bernstein coefficient of c·W − N
+/// (degree 5, N and W the arc's numerator and denominator) over the least
+/// value of W, plus a margin for double rounding.
+FDSURF_NODISCARD CubicArc ApproximateArc(const RationalQuadratic& arc);
+
+/// Cubics covering the arc in order, each with bound ≤ tolerance: the arc is
+/// halved until each piece's bound is met. Throws ConstructionError when that
+/// takes more than 2^20 pieces (a tolerance below the arithmetic's rounding).
+std::vector<CubicArc> ArcToCubics(const RationalQuadratic& arc, double tolerance);
+
+}  // namespace fdsurf::host
