@@ -86,6 +86,13 @@ TEST(Obj, NegativeIndicesCountBackFromTheLatest) {
   for (const Point3& n : mesh.normals) EXPECT_EQ(n, (Point3{0, 0, 1}));
 }
 
+TEST(Obj, PositiveIndicesMayNameLaterStatements) {
+  const TriangleMesh mesh =
+      ParseObj("f 1//2 2//2 3//1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\n", "t.obj");
+  EXPECT_EQ(mesh.triangles, (Triangles{{0, 1, 2}}));
+  for (const Point3& n : mesh.normals) EXPECT_EQ(n, (Point3{0, 0, 1}));
+}
+
 TEST(Obj, FansPolygons) {
   // A convex pentagon and a quad: fans from the first corner.
   const TriangleMesh mesh = ParseObj(
@@ -439,6 +446,18 @@ TEST(Ply, EstimatesAreaWeightedNormalsOnACube) {
   const TriangleMesh mesh = ParsePly(text, "cube.ply");
   ExpectCubeCornerNormals(mesh);
   EXPECT_TRUE(mesh.normals_estimated);
+}
+
+TEST(Ply, AVertexInNoFaceIsKeptWhenTheFileGivesItsNormal) {
+  const TriangleMesh mesh = ParsePly(
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n5 5 5 1 0 0\n3 0 1 2\n",
+      "m.ply");
+  EXPECT_EQ(mesh.vertices.size(), 4u);
+  EXPECT_EQ(mesh.normals[3], (Point3{1, 0, 0}));
+  EXPECT_TRUE(mesh.notes.empty());
 }
 
 std::string PlyError(const std::string& bytes) {
