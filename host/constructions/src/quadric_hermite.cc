@@ -677,146 +677,96 @@ void ReportJoins(QuadricBuild& b) {
 
 namespace {
 
-// The seed's conditions on one triangle (i, j, k) have a solution only when
-// C = (A_i·e_ij)(A_j·e_jk)(A_k·e_ki) + (A_j·e_ij)(A_k·e_jk)(A_i·e_ki) = 0:
-// for a quadric F(P_j) − F(P_i) = ½(∇F(P_i) + ∇F(P_j))·e_ij exactly, so
-// λ_i·A_i·e_ij + λ_j·A_j·e_ij = 0 on each edge, three equations for the two
-// free λ. Returns C over |e_ij|·|e_jk|·|e_ki| (a product of three cosines)
-// and its gradient in the three normals; *terms gets |first| + |second| on
-// the same scale.
-double Compatibility(const std::array<Point3, 3>& p, const std::array<Point3, 3>& a,
-                     std::array<Point3, 3>* gradient, double* terms) {
-  std::array<Point3, 3> e{};  // e[k] = p[k+1] − p[k]
-  for (int k = 0; k < 3; ++k) e[k] = Sub(p[(k + 1) % 3], p[k]);
-  // out[k] = A_k·e_k (along its edge forward), in[k] = A_k·e_(k−1) (the
-  // edge arriving at it).
-  double out[3];
-  double in[3];
-  for (int k = 0; k < 3; ++k) {
-    out[k] = Dot(a[k], e[k]);
-    in[k] = Dot(a[k], e[(k + 2) % 3]);
-  }
-  const double scale = Norm(e[0]) * Norm(e[1]) * Norm(e[2]);
-  const double first = out[0] * out[1] * out[2];
-  const double second = in[1] * in[2] * in[0];
-  for (int k = 0; k < 3; ++k) {
-    const int k1 = (k + 1) % 3;
-    const int k2 = (k + 2) % 3;
-    (*gradient)[k] =
-        Scale(Add(Scale(e[k], out[k1] * out[k2]), Scale(e[k2], in[k1] * in[k2])), 1 / scale);
-  }
-  *terms = (std::fabs(first) + std::fabs(second)) / scale;
-  return (first + second) / scale;
-}
-
-// Conjugate gradients on J·Jᵀ·y = b, J given by its rows (9 entries each:
-// the tangent-plane derivatives for the triangle's 3 vertices).
-struct SparseRows {
-  std::vector<std::array<int, 3>> vertex;
-  std::vector<std::array<double, 6>> value;  // per vertex (d/dt1, d/dt2)
-};
-
-std::vector<double> SolveNormalEquations(const SparseRows& j, std::size_t vertices,
-                                         const std::vector<double>& b) {
-  const std::size_t n = b.size();
-  const auto apply = [&](const std::vector<double>& y) {
-    std::vector<double> x(2 * vertices, 0.0);  // Jᵀ·y
-    for (std::size_t r = 0; r < n; ++r) {
+// The seed's conditions on a triangle have a solution only when its normals
+// are compatible (docs/constructions.md, row 12, "Compatible normals"): for
+// a quadric, F(P_j) − F(P_i) = ½(∇F(P_i) + ∇F(P_j))·e_ij exactly
+// (e_ij = P_j − P_i), so on every edge λ_i·A_i·e_ij + λ_j·A_j·e_ij = 0, three
+// equations for the triangle's two free λ. Over a mesh whose every closed
+// path bounds triangles, that holds on every triangle exactly when there are
+// vectors g_v ∥ A_v, none zero, with (g_i + g_j)·e_ij = 0 on every edge: a
+// linear space N of vector fields on the vertices.
+//
+// The nearest such field to the unit normals: g = A − Bᵀ·(B·Bᵀ)⁻¹·B·A, B the
+// edge rows, by conjugate gradients on B·Bᵀ.
+std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_deg,
+                                      double* largest_turn_deg) {
+  std::vector<std::pair<int, int>> edges;
+  {
+    std::map<std::pair<int, int>, int> seen;
+    for (const auto& tri : mesh.triangles) {
       for (int k = 0; k < 3; ++k) {
-        x[2 * j.vertex[r][k]] += j.value[r][2 * k] * y[r];
-        x[2 * j.vertex[r][k] + 1] += j.value[r][2 * k + 1] * y[r];
+        const auto key = std::minmax(tri[k], tri[(k + 1) % 3]);
+        if (seen.emplace(key, 0).second) edges.push_back(key);
       }
     }
-    std::vector<double> out(n, 0.0);  // J·x
-    for (std::size_t r = 0; r < n; ++r) {
-      for (int k = 0; k < 3; ++k) {
-        out[r] += j.value[r][2 * k] * x[2 * j.vertex[r][k]] +
-                  j.value[r][2 * k + 1] * x[2 * j.vertex[r][k] + 1];
-      }
-      out[r] += 1e-14 * y[r];  // a whisper of damping for rank-deficient J
+  }
+  std::vector<Point3> a;
+  for (const Point3& n : mesh.normals) a.push_back(Unit(n));
+  // Rows scaled to unit edge length, so that every edge weighs the same.
+  std::vector<Point3> dir;
+  for (const auto& [i, j] : edges) dir.push_back(Unit(Sub(mesh.vertices[j], mesh.vertices[i])));
+  const auto transpose_times = [&](const std::vector<double>& y) {  // Bᵀ·y
+    std::vector<Point3> x(a.size(), Point3{0, 0, 0});
+    for (std::size_t r = 0; r < edges.size(); ++r) {
+      x[edges[r].first] = Add(x[edges[r].first], Scale(dir[r], y[r]));
+      x[edges[r].second] = Add(x[edges[r].second], Scale(dir[r], y[r]));
+    }
+    return x;
+  };
+  const auto times = [&](const std::vector<Point3>& x) {  // B·x
+    std::vector<double> out(edges.size());
+    for (std::size_t r = 0; r < edges.size(); ++r) {
+      out[r] = Dot(Add(x[edges[r].first], x[edges[r].second]), dir[r]);
     }
     return out;
   };
-  std::vector<double> y(n, 0.0);
-  std::vector<double> r = b;
+  const std::vector<double> rhs = times(a);
+  std::vector<double> y(edges.size(), 0.0);
+  std::vector<double> r = rhs;
   std::vector<double> d = r;
   double rr = 0;
   for (double v : r) rr += v * v;
-  const double target = 1e-28 * std::max(rr, 1e-300);
-  for (std::size_t it = 0; it < 4 * n + 20 && rr > target; ++it) {
-    const std::vector<double> ad = apply(d);
+  const double start = rr;
+  for (std::size_t it = 0; it < 20 * edges.size() + 100 && rr > 1e-30 * start; ++it) {
+    const std::vector<double> ad = times(transpose_times(d));
     double dad = 0;
-    for (std::size_t i = 0; i < n; ++i) dad += d[i] * ad[i];
+    for (std::size_t k = 0; k < d.size(); ++k) dad += d[k] * ad[k];
     if (!(dad > 0)) break;
     const double alpha = rr / dad;
     double next = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      y[i] += alpha * d[i];
-      r[i] -= alpha * ad[i];
-      next += r[i] * r[i];
+    for (std::size_t k = 0; k < d.size(); ++k) {
+      y[k] += alpha * d[k];
+      r[k] -= alpha * ad[k];
+      next += r[k] * r[k];
     }
-    for (std::size_t i = 0; i < n; ++i) d[i] = r[i] + (next / rr) * d[i];
+    for (std::size_t k = 0; k < d.size(); ++k) d[k] = r[k] + (next / rr) * d[k];
     rr = next;
   }
-  return y;
-}
-
-// Gauss-Newton on the normals' directions: each step is the least turn (to
-// first order) that zeroes every triangle's C, until each |C| is below
-// 1e-10 of its terms.
-std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double* largest_turn_deg) {
-  std::vector<Point3> a;
-  for (const Point3& n : mesh.normals) a.push_back(Unit(n));
-  constexpr int kSteps = 60;
-  for (int step = 0;; ++step) {
-    // Each normal turns in its tangent plane, spanned by t1, t2.
-    std::vector<std::array<Point3, 2>> tangent(a.size());
-    for (std::size_t v = 0; v < a.size(); ++v) {
-      Point3 t1 = Cross(a[v], std::fabs(a[v][0]) < 0.6 ? Point3{1, 0, 0} : Point3{0, 1, 0});
-      t1 = Unit(t1);
-      tangent[v] = {t1, Cross(a[v], t1)};
-    }
-    SparseRows rows;
-    std::vector<double> rhs;
-    double worst = 0;
-    for (const auto& tri : mesh.triangles) {
-      const std::array<Point3, 3> p = {mesh.vertices[tri[0]], mesh.vertices[tri[1]],
-                                       mesh.vertices[tri[2]]};
-      std::array<Point3, 3> g{};
-      double terms = 0;
-      const double c = Compatibility(p, {a[tri[0]], a[tri[1]], a[tri[2]]}, &g, &terms);
-      if (std::fabs(c) > 1e-10 * terms) worst = std::max(worst, std::fabs(c) / terms);
-      std::array<double, 6> value{};
-      for (int k = 0; k < 3; ++k) {
-        value[2 * k] = Dot(g[k], tangent[tri[k]][0]);
-        value[2 * k + 1] = Dot(g[k], tangent[tri[k]][1]);
-      }
-      rows.vertex.push_back(tri);
-      rows.value.push_back(value);
-      rhs.push_back(-c);
-    }
-    if (worst == 0) break;
-    if (step == kSteps) {
-      throw ConstructionError("the normals cannot be turned so that every triangle's conditions "
-                              "have a solution (still " + FormatNumber(worst) +
-                              " of the terms off after " + std::to_string(kSteps) + " steps)");
-    }
-    const std::vector<double> y = SolveNormalEquations(rows, a.size(), rhs);
-    std::vector<Point3> delta(a.size(), Point3{0, 0, 0});
-    for (std::size_t r = 0; r < y.size(); ++r) {
-      for (int k = 0; k < 3; ++k) {
-        const int v = rows.vertex[r][k];
-        delta[v] = Add(delta[v], Add(Scale(tangent[v][0], rows.value[r][2 * k] * y[r]),
-                                     Scale(tangent[v][1], rows.value[r][2 * k + 1] * y[r])));
-      }
-    }
-    for (std::size_t v = 0; v < a.size(); ++v) a[v] = Unit(Add(a[v], delta[v]));
-  }
+  const std::vector<Point3> correction = transpose_times(y);
+  std::vector<Point3> g(a.size());
   *largest_turn_deg = 0;
+  double total_turn = 0;
   for (std::size_t v = 0; v < a.size(); ++v) {
-    *largest_turn_deg = std::max(*largest_turn_deg, LineAngle(a[v], mesh.normals[v]));
+    g[v] = Sub(a[v], correction[v]);
+    if (!(Norm(g[v]) > 1e-6)) {
+      throw ConstructionError("vertex " + std::to_string(v) +
+                              ": no compatible normal near the given one (the nearest field of "
+                              "compatible normals vanishes there)");
+    }
+    g[v] = Unit(g[v]);
+    *largest_turn_deg = std::max(*largest_turn_deg, LineAngle(g[v], a[v]));
+    total_turn += LineAngle(g[v], a[v]);
   }
-  return a;
+  if (*largest_turn_deg > max_turn_deg) {
+    throw ConstructionError(
+        "the normals would have to turn by up to " + FormatNumber(*largest_turn_deg, 3) +
+        " degrees (" + FormatNumber(total_turn / static_cast<double>(a.size()), 3) +
+        " on average) for every triangle's conditions to have a solution; more than " +
+        FormatNumber(max_turn_deg) +
+        " changes the surface, so it is refused (these vertices do not lie near a surface whose "
+        "pieces are quadrics meeting this way: see docs/constructions.md, \"Compatible normals\")");
+  }
+  return g;
 }
 
 }  // namespace
@@ -831,7 +781,7 @@ QuadricResult BuildQuadricMesh(const QuadricMesh& given, double tolerance,
     for (const auto& tri : given.triangles) {
       CheckTriangleIndices(given, tri, "a triangle");
     }
-    mesh.normals = CompatibleNormals(given, &turn);
+    mesh.normals = CompatibleNormals(given, given.max_normal_turn_deg, &turn);
   }
   QuadricBuild build{mesh, tolerance, origin, {}, {}, {}, {}};
   if (given.adjust_normals) {

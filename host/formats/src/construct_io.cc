@@ -2,12 +2,14 @@
 #include "construct_io.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <initializer_list>
 
 #include "fdsurf/host/constructions.h"
 #include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/mesh_io.h"
 #include "fdsurf/host/quadric_hermite.h"
 #include "fdsurf/host/text.h"
 
@@ -419,13 +421,13 @@ void ParseMu(const json& e, const Place& place, QuadricMesh* mesh) {
   }
 }
 
-void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
-  CheckFields(e, place,
-              {"type", "vertices", "normals", "triangles", "free", "mu", "sections", "tolerance"},
-              {"vertices", "normals", "triangles"});
-  QuadricMesh mesh;
-  mesh.vertices = ParsePoints(e["vertices"], place.Child("vertices"), 3);
-  mesh.normals = ParsePoints(e["normals"], place.Child("normals"), 3);
+// Vertices, normals and triangles from the entry's own arrays.
+void ParseInlineMesh(const json& e, const Place& place, QuadricMesh* mesh) {
+  for (const char* key : {"vertices", "normals", "triangles"}) {
+    if (!e.contains(key)) throw place.Error(std::string("missing \"") + key + "\" (or \"mesh\")");
+  }
+  mesh->vertices = ParsePoints(e["vertices"], place.Child("vertices"), 3);
+  mesh->normals = ParsePoints(e["normals"], place.Child("normals"), 3);
   const Place tp = place.Child("triangles");
   const json& triangles = e["triangles"];
   if (!triangles.is_array() || triangles.empty()) {
@@ -439,7 +441,35 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
       if (!tri[k].is_number_integer()) throw tp.Index(t).Index(k).Error("must be a vertex index");
       indices[k] = tri[k].get<int>();
     }
-    mesh.triangles.push_back(indices);
+    mesh->triangles.push_back(indices);
+  }
+}
+
+// "mesh": an OBJ or PLY file, relative to the JSON file's folder.
+void ReadMeshField(const json& e, const Place& place, QuadricMesh* mesh, PatchSet* set) {
+  if (e.contains("vertices") || e.contains("normals") || e.contains("triangles")) {
+    throw place.Error(R"(give "mesh" or "vertices", "normals" and "triangles", not both)");
+  }
+  if (!e["mesh"].is_string()) throw place.Child("mesh").Error("must be the path of an OBJ or PLY file");
+  std::filesystem::path path = e["mesh"].get<std::string>();
+  if (path.is_relative()) path = std::filesystem::path(place.file).parent_path() / path;
+  TriangleMesh file = ReadMeshFile(path.string());
+  mesh->vertices = std::move(file.vertices);
+  mesh->normals = std::move(file.normals);
+  mesh->triangles = std::move(file.triangles);
+  for (std::string& note : file.notes) set->notes.push_back(std::move(note));
+}
+
+void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
+  CheckFields(e, place,
+              {"type", "mesh", "vertices", "normals", "triangles", "free", "mu", "sections",
+               "adjust_normals", "tolerance"},
+              {});
+  QuadricMesh mesh;
+  if (e.contains("mesh")) {
+    ReadMeshField(e, place, &mesh, set);
+  } else {
+    ParseInlineMesh(e, place, &mesh);
   }
   if (e.contains("free")) {
     const Place fp = place.Child("free");
@@ -455,6 +485,7 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
     }
     mesh.sections = e["sections"].get<int>();
   }
+  if (e.contains("adjust_normals")) mesh.adjust_normals = Bool(e["adjust_normals"], place.Child("adjust_normals"));
   const double tolerance = Tolerance(e, place, 1e-3);
   try {
     QuadricResult result = BuildQuadricMesh(mesh, tolerance, SegmentOrigin(place, 0, 1));
@@ -464,6 +495,41 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
     throw place.Error(error.what());
   }
 }
+
+}  // namespace
+
+PatchSet MeshFileAsPatchSet(const std::string& path) {
+  TriangleMesh file = ReadMeshFile(path);
+  PatchSet set;
+  set.notes = std::move(file.notes);
+  QuadricMesh mesh;
+  mesh.vertices = std::move(file.vertices);
+  mesh.normals = std::move(file.normals);
+  mesh.triangles = std::move(file.triangles);
+  mesh.mu_from_normals = true;
+  mesh.adjust_normals = true;
+  // The default tolerance follows the mesh's size, as files come in metres,
+  // millimetres or inches: 1e-5 of the largest extent.
+  Point3 lo = mesh.vertices.front();
+  Point3 hi = lo;
+  for (const Point3& v : mesh.vertices) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], v[c]);
+      hi[c] = std::max(hi[c], v[c]);
+    }
+  }
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  try {
+    QuadricResult result = BuildQuadricMesh(mesh, 1e-5 * extent, path + ": quadric-hermite");
+    set.curves = std::move(result.curves);
+    for (std::string& note : result.notes) set.notes.push_back(std::move(note));
+  } catch (const ConstructionError& error) {
+    throw InputError(path + ": " + error.what());
+  }
+  return set;
+}
+
+namespace {
 
 std::string PolyText(const VecPoly& p, int c) {
   std::string text;

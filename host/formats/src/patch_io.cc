@@ -304,6 +304,7 @@ Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
 }
 
 PatchSet ReadPatchFile(const std::string& path) {
+  if (EndsWith(path, ".obj") || EndsWith(path, ".ply")) return MeshFileAsPatchSet(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
   std::ostringstream buffer;

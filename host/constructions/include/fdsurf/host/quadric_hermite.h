@@ -93,8 +93,12 @@ struct QuadricMesh {
   /// conditions have a solution: they do only when
   /// (A_i·e_ij)(A_j·e_jk)(A_k·e_ki) = −(A_j·e_ij)(A_k·e_jk)(A_i·e_ki)
   /// (e_ij = P_j − P_i), which normals from a file rarely meet exactly.
-  /// Off: such a triangle is refused.
+  /// The normals are replaced by the nearest field of compatible ones
+  /// (docs/constructions.md, row 12). Off: such a triangle is refused.
   bool adjust_normals = false;
+  /// The largest turn (degrees) adjust_normals may make; a mesh that needs
+  /// more is refused.
+  double max_normal_turn_deg = 30;
 };
 
 struct QuadricPiece {
