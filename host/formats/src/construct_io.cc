@@ -509,7 +509,8 @@ PatchSet MeshFileAsPatchSet(const std::string& path) {
   mesh.mu_from_normals = true;
   mesh.adjust_normals = true;
   // The default tolerance follows the mesh's size, as files come in metres,
-  // millimetres or inches: 1e-5 of the largest extent.
+  // millimetres or inches: 1e-4 of the largest extent (0.01 mm on a 100 mm
+  // drawing, below a plotter's step).
   Point3 lo = mesh.vertices.front();
   Point3 hi = lo;
   for (const Point3& v : mesh.vertices) {
@@ -520,7 +521,7 @@ PatchSet MeshFileAsPatchSet(const std::string& path) {
   }
   const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   try {
-    QuadricResult result = BuildQuadricMesh(mesh, 1e-5 * extent, path + ": quadric-hermite");
+    QuadricResult result = BuildQuadricMesh(mesh, 1e-4 * extent, path + ": quadric-hermite");
     set.curves = std::move(result.curves);
     for (std::string& note : result.notes) set.notes.push_back(std::move(note));
   } catch (const ConstructionError& error) {

@@ -39,7 +39,7 @@ void AddConstructions(const nlohmann::json& construct, const std::string& file, 
 /// Reads an OBJ or PLY mesh and draws it as quadric Hermite pieces (row 12
 /// of docs/constructions.md) with μ from its normals, the normals turned
 /// where the triangles' conditions need it, 8 sections per piece and a
-/// tolerance of 1e-5 of the mesh's extent. Throws InputError naming the file.
+/// tolerance of 1e-4 of the mesh's extent. Throws InputError naming the file.
 PatchSet MeshFileAsPatchSet(const std::string& path);
 
 /// Appends the curves of every entry in `curves` (a JSON array) to `set`.
