@@ -304,7 +304,9 @@ Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
 }
 
 PatchSet ReadPatchFile(const std::string& path) {
-  if (EndsWith(path, ".obj") || EndsWith(path, ".ply")) return MeshFileAsPatchSet(path);
+  std::string lower = path.substr(path.size() >= 4 ? path.size() - 4 : 0);
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (lower == ".obj" || lower == ".ply") return MeshFileAsPatchSet(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
   std::ostringstream buffer;

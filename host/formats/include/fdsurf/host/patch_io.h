@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Reading patch files: BPT text and fdsurf JSON (docs/formats.md).
+// Reading drawings: BPT text, fdsurf JSON, and OBJ/PLY meshes (docs/formats.md).
 #pragma once
 
 #include <string>
@@ -9,9 +9,11 @@
 
 namespace fdsurf::host {
 
-/// Reads a BPT or JSON patch file; the format is taken from the extension
-/// (.bpt, .json) or, failing that, from the first non-blank character.
-/// Throws InputError on anything malformed.
+/// Reads a BPT or JSON patch file, or an OBJ or PLY triangle mesh drawn as
+/// quadric Hermite pieces (curves; docs/formats.md). The format is taken from
+/// the extension (.bpt, .json; .obj, .ply in any case) or, failing that, from
+/// the first non-blank character. Throws InputError on anything malformed or
+/// a mesh the construction refuses.
 PatchSet ReadPatchFile(const std::string& path);
 
 /// The same from text already in memory; `name` is used in messages.
