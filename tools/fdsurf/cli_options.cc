@@ -43,7 +43,10 @@ Grid ParseGrid(const std::string& text) {
 }
 
 void AddGridOptions(CLI::App* command, GridOptions* options) {
-  command->add_option("FILE", options->file, "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+  command
+      ->add_option(
+          "FILE", options->file,
+          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
       ->required();
   command
       ->add_option("--grid", options->grid,

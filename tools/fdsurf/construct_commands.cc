@@ -72,7 +72,10 @@ double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps) {
 }
 
 void AddJoinsOptions(CLI::App* command, JoinsOptions* options) {
-  command->add_option("FILE", options->file, "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+  command
+      ->add_option(
+          "FILE", options->file,
+          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
       ->required();
   command
       ->add_option("--tolerance", options->tolerance,

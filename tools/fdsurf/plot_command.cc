@@ -172,7 +172,10 @@ int RunPlot(const PlotOptions& o, bool render_only) {
 }
 
 void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
-  command->add_option("FILE", o->file, "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+  command
+      ->add_option(
+          "FILE", o->file,
+          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
       ->required();
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();

@@ -59,7 +59,10 @@ MachineOptions Machine(const StreamOptions& o) {
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
-  command->add_option("FILE", o->file, "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+  command
+      ->add_option(
+          "FILE", o->file,
+          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
       ->required();
   command
       ->add_option("--device", o->device,

@@ -15,9 +15,8 @@ namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 double Binomial(int n, int k) {
-  static const double kTable[6][6] = {{1, 0, 0, 0, 0, 0},  {1, 1, 0, 0, 0, 0},
-                                      {1, 2, 1, 0, 0, 0},  {1, 3, 3, 1, 0, 0},
-                                      {1, 4, 6, 4, 1, 0},  {1, 5, 10, 10, 5, 1}};
+  static const double kTable[6][6] = {{1, 0, 0, 0, 0, 0}, {1, 1, 0, 0, 0, 0}, {1, 2, 1, 0, 0, 0},
+                                      {1, 3, 3, 1, 0, 0}, {1, 4, 6, 4, 1, 0}, {1, 5, 10, 10, 5, 1}};
   return kTable[n][k];
 }
 
@@ -42,8 +41,7 @@ void SplitArc(const RationalQuadratic& arc, RationalQuadratic* first, RationalQu
   const double w = arc.w;
   const Point3 left = Scale(Add(arc.p0, Scale(arc.p1, w)), 1 / (1 + w));
   const Point3 right = Scale(Add(arc.p2, Scale(arc.p1, w)), 1 / (1 + w));
-  const Point3 middle =
-      Scale(Add(Add(arc.p0, Scale(arc.p1, 2 * w)), arc.p2), 1 / (2 + 2 * w));
+  const Point3 middle = Scale(Add(Add(arc.p0, Scale(arc.p1, 2 * w)), arc.p2), 1 / (2 + 2 * w));
   const double half_weight = std::sqrt((1 + w) / 2);
   *first = RationalQuadratic{arc.p0, left, middle, half_weight};
   *second = RationalQuadratic{middle, right, arc.p2, half_weight};

@@ -72,7 +72,8 @@ std::vector<double> QuadraticRoots(double alpha, double beta, double gamma) {
   }
   const double discriminant = beta * beta - alpha * gamma;
   if (discriminant < 0) return {};
-  const double sum = beta >= 0 ? -(beta + std::sqrt(discriminant)) : -(beta - std::sqrt(discriminant));
+  const double sum =
+      beta >= 0 ? -(beta + std::sqrt(discriminant)) : -(beta - std::sqrt(discriminant));
   if (sum == 0) return {0.0};
   return {sum / alpha, gamma / sum};
 }
@@ -301,7 +302,7 @@ void SectionBranch::ArcSpan(double t0, double t1, int depth,
   // quadratic with Bernstein weights W_j and points N_j / W_j.
   const double d0[2] = {std::cos(t0), std::sin(t0)};
   const double d1[2] = {std::cos(t1), std::sin(t1)};
-  const auto form = [&](const double (&x)[2], const double (&y)[2]) {
+  const auto form = [&](const double(&x)[2], const double(&y)[2]) {
     return quad_[0] * x[0] * y[0] + quad_[1] * (x[0] * y[1] + x[1] * y[0]) + quad_[2] * x[1] * y[1];
   };
   const double w0 = form(d0, d0);
@@ -316,16 +317,15 @@ void SectionBranch::ArcSpan(double t0, double t1, int depth,
     ArcSpan(middle, t1, depth + 1, out);
     return;
   }
-  const auto point = [&](double weight_j, double a, const double (&da)[2], double b,
-                         const double (&db)[2]) {
+  const auto point = [&](double weight_j, double a, const double(&da)[2], double b,
+                         const double(&db)[2]) {
     // (K·W_j − (a·db + b·da)) / W_j, with a, b the G·d products.
     const double u = k_[0] - (a * db[0] + b * da[0]) / weight_j;
     const double v = k_[1] - (a * db[1] + b * da[1]) / weight_j;
     return ToSpace(u, v);
   };
-  out->push_back(
-      RationalQuadratic{point(w0, g0, d0, g0, d0), point(w1, g0, d0, g1, d1), point(w2, g1, d1, g1, d1),
-                        weight});
+  out->push_back(RationalQuadratic{point(w0, g0, d0, g0, d0), point(w1, g0, d0, g1, d1),
+                                   point(w2, g1, d1, g1, d1), weight});
 }
 
 std::vector<SectionBranch> SectionOf(const Quadric& f, const Point3& origin, const Point3& e1,

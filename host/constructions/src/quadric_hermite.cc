@@ -188,7 +188,6 @@ QuadricSolution SolveQuadricTriangle(const std::array<Point3, 3>& p,
   return solution;
 }
 
-
 namespace {
 
 // The working state of BuildQuadricMesh, filled in by its stages in order.
@@ -217,7 +216,6 @@ void GoldenSection(const F& f, int iterations, double* lo, double* hi) {
     }
   }
 }
-
 
 void ValidateMesh(const QuadricMesh& mesh) {
   if (mesh.normals.size() != mesh.vertices.size()) {
@@ -281,7 +279,6 @@ std::string PieceNote(const std::string& origin, const std::string& name, const 
   return note;
 }
 
-
 // μ from the normals: |A₁| times the mean over the edges of the normal
 // curvature (g_i − g_j)·(P_i − P_j)/|P_i − P_j|², 1/r on a sphere of radius r.
 double MuFromNormals(const std::array<Point3, 3>& p, const std::array<Point3, 3>& n) {
@@ -327,15 +324,16 @@ void SolvePieces(QuadricBuild& b) {
                               std::to_string(mesh.free[t].size()));
     }
     if (mu_given && !mesh.free.empty() && free_count == 1) {
-      throw ConstructionError(name + ": give either \"free\" or \"mu\": both choose the one free "
-                                     "parameter");
+      throw ConstructionError(name +
+                              ": give either \"free\" or \"mu\": both choose the one free "
+                              "parameter");
     }
     piece.parameters = mesh.free.empty() ? std::vector<double>(free_count, 0.0) : mesh.free[t];
     piece.quadric = piece.solution.With(piece.parameters);
     piece.plane_normal = Unit(Cross(Sub(p[1], p[0]), Sub(p[2], p[0])));
     if (mu_given) {
-      const double mu = mesh.mu_from_normals ? MuFromNormals(p, n)
-                                             : mesh.mu[mesh.mu.size() == 1 ? 0 : t];
+      const double mu =
+          mesh.mu_from_normals ? MuFromNormals(p, n) : mesh.mu[mesh.mu.size() == 1 ? 0 : t];
       SetMu(mu, piece.plane_normal, &piece.quadric);
     }
     piece.mu = piece.quadric.Form(piece.plane_normal, piece.plane_normal);
@@ -422,7 +420,6 @@ struct EdgePair {
     return std::sqrt(cross / (n1 * n2));
   }
 };
-
 
 // The angle θ of the glue plane: the reference plane through the edge along
 // `along`, the mean of the given normals at its ends (or, where that lies
@@ -584,11 +581,11 @@ void DrawPieces(QuadricBuild& b) {
       arc.drawn = other < 0 || other > static_cast<int>(t);
       b.result.bound = std::max(b.result.bound, arc.bound);
       if (arc.drawn) {
-        const std::string what =
-            arc.role == QuadricArc::Role::kOutline
-                ? " outline " + std::to_string(mesh.triangles[t][arc.index]) + "-" +
-                      std::to_string(mesh.triangles[t][(arc.index + 1) % 3])
-                : " section " + std::to_string(arc.index);
+        const std::string what = arc.role == QuadricArc::Role::kOutline
+                                     ? " outline " + std::to_string(mesh.triangles[t][arc.index]) +
+                                           "-" +
+                                           std::to_string(mesh.triangles[t][(arc.index + 1) % 3])
+                                     : " section " + std::to_string(arc.index);
         for (const CubicArc& cubic : arc.cubics) {
           Curve curve;
           curve.basis = Basis::kBezier;
@@ -650,7 +647,6 @@ std::string GlueNote(const std::string& origin, const QuadricGlue& glue) {
   return note;
 }
 
-
 // Stage 6: how well each glued pair joins (C0 or G1), and the summary note.
 void ReportJoins(QuadricBuild& b) {
   QuadricResult& result = b.result;
@@ -667,8 +663,7 @@ void ReportJoins(QuadricBuild& b) {
   result.notes.push_back(b.origin + ": " + std::to_string(result.pieces.size()) +
                          " pieces drawn as " + std::to_string(result.curves.size()) +
                          " cubic curves (" + std::to_string(outlines) + " outline and " +
-                         std::to_string(sections) +
-                         " section conic arcs); every point within " +
+                         std::to_string(sections) + " section conic arcs); every point within " +
                          FormatNumber(result.bound) + " of its quadric piece, proven (tolerance " +
                          FormatNumber(b.tolerance) + ")");
 }
@@ -677,33 +672,28 @@ void ReportJoins(QuadricBuild& b) {
 
 namespace {
 
-// The seed's conditions on a triangle have a solution only when its normals
-// are compatible (docs/constructions.md, row 12, "Compatible normals"): for
-// a quadric, F(P_j) − F(P_i) = ½(∇F(P_i) + ∇F(P_j))·e_ij exactly
-// (e_ij = P_j − P_i), so on every edge λ_i·A_i·e_ij + λ_j·A_j·e_ij = 0, three
-// equations for the triangle's two free λ. Over a mesh whose every closed
-// path bounds triangles, that holds on every triangle exactly when there are
-// vectors g_v ∥ A_v, none zero, with (g_i + g_j)·e_ij = 0 on every edge: a
-// linear space N of vector fields on the vertices.
-//
-// The nearest such field to the unit normals: g = A − Bᵀ·(B·Bᵀ)⁻¹·B·A, B the
-// edge rows, by conjugate gradients on B·Bᵀ.
-std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_deg,
-                                      double* largest_turn_deg) {
+// The mesh's edges, each once, as (lower, higher) vertex index.
+std::vector<std::pair<int, int>> EdgesOf(const QuadricMesh& mesh) {
   std::vector<std::pair<int, int>> edges;
-  {
-    std::map<std::pair<int, int>, int> seen;
-    for (const auto& tri : mesh.triangles) {
-      for (int k = 0; k < 3; ++k) {
-        const auto key = std::minmax(tri[k], tri[(k + 1) % 3]);
-        if (seen.emplace(key, 0).second) edges.push_back(key);
-      }
+  std::map<std::pair<int, int>, int> seen;
+  for (const auto& tri : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::pair<int, int> key(std::min(tri[k], tri[(k + 1) % 3]),
+                                    std::max(tri[k], tri[(k + 1) % 3]));
+      if (seen.emplace(key, 0).second) edges.push_back(key);
     }
   }
-  std::vector<Point3> a;
-  for (const Point3& n : mesh.normals) a.push_back(Unit(n));
-  // Rows scaled to unit edge length, so that every edge weighs the same.
+  return edges;
+}
+
+// The edge rows B of N's equations (g_i + g_j)·u_ij = 0 (u_ij the unit edge
+// direction, so that every edge weighs the same), applied by conjugate
+// gradients to find y with (B·Bᵀ)·y = B·a: then a − Bᵀ·y is the nearest
+// field in N to a. Returns Bᵀ·y.
+std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vector<Point3>& a) {
+  const std::vector<std::pair<int, int>> edges = EdgesOf(mesh);
   std::vector<Point3> dir;
+  dir.reserve(edges.size());
   for (const auto& [i, j] : edges) dir.push_back(Unit(Sub(mesh.vertices[j], mesh.vertices[i])));
   const auto transpose_times = [&](const std::vector<double>& y) {  // Bᵀ·y
     std::vector<Point3> x(a.size(), Point3{0, 0, 0});
@@ -720,9 +710,8 @@ std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_d
     }
     return out;
   };
-  const std::vector<double> rhs = times(a);
   std::vector<double> y(edges.size(), 0.0);
-  std::vector<double> r = rhs;
+  std::vector<double> r = times(a);
   std::vector<double> d = r;
   double rr = 0;
   for (double v : r) rr += v * v;
@@ -742,7 +731,25 @@ std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_d
     for (std::size_t k = 0; k < d.size(); ++k) d[k] = r[k] + (next / rr) * d[k];
     rr = next;
   }
-  const std::vector<Point3> correction = transpose_times(y);
+  return transpose_times(y);
+}
+
+// The seed's conditions on a triangle have a solution only when its normals
+// are compatible (docs/constructions.md, row 12, "Compatible normals"): for
+// a quadric, F(P_j) − F(P_i) = ½(∇F(P_i) + ∇F(P_j))·e_ij exactly
+// (e_ij = P_j − P_i), so on every edge λ_i·A_i·e_ij + λ_j·A_j·e_ij = 0, three
+// equations for the triangle's two free λ. Over a mesh whose every closed
+// path bounds triangles, that holds on every triangle exactly when there are
+// vectors g_v ∥ A_v, none zero, with (g_i + g_j)·e_ij = 0 on every edge: a
+// linear space N of vector fields on the vertices. The nearest field in N to
+// the unit normals, normalised, is compatible; it is refused when it turns a
+// normal by more than max_turn_deg or vanishes at a vertex.
+std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_deg,
+                                      double* largest_turn_deg) {
+  std::vector<Point3> a;
+  a.reserve(mesh.normals.size());
+  for (const Point3& n : mesh.normals) a.push_back(Unit(n));
+  const std::vector<Point3> correction = ProjectionCorrection(mesh, a);
   std::vector<Point3> g(a.size());
   *largest_turn_deg = 0;
   double total_turn = 0;
@@ -771,25 +778,24 @@ std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_d
 
 }  // namespace
 
-QuadricResult BuildQuadricMesh(const QuadricMesh& given, double tolerance,
+QuadricResult BuildQuadricMesh(const QuadricMesh& mesh_in, double tolerance,
                                const std::string& origin) {
-  ValidateMesh(given);
+  ValidateMesh(mesh_in);
   if (!(tolerance > 0)) throw ConstructionError("the tolerance must be positive");
-  QuadricMesh mesh = given;
+  QuadricMesh mesh = mesh_in;
   double turn = 0;
-  if (given.adjust_normals) {
-    for (const auto& tri : given.triangles) {
-      CheckTriangleIndices(given, tri, "a triangle");
+  if (mesh_in.adjust_normals) {
+    for (std::size_t t = 0; t < mesh_in.triangles.size(); ++t) {
+      CheckTriangleIndices(mesh_in, mesh_in.triangles[t], "triangles[" + std::to_string(t) + "]");
     }
-    mesh.normals = CompatibleNormals(given, given.max_normal_turn_deg, &turn);
+    mesh.normals = CompatibleNormals(mesh_in, mesh_in.max_normal_turn_deg, &turn);
   }
   QuadricBuild build{mesh, tolerance, origin, {}, {}, {}, {}};
-  if (given.adjust_normals) {
+  if (mesh_in.adjust_normals) {
     build.result.normals = mesh.normals;
     build.result.largest_normal_turn_deg = turn;
-    build.result.notes.push_back(
-        origin + ": normals turned by up to " + FormatNumber(turn) +
-        " degrees so that every triangle's conditions have a solution");
+    build.result.notes.push_back(origin + ": normals turned by up to " + FormatNumber(turn) +
+                                 " degrees so that every triangle's conditions have a solution");
   }
   SolvePieces(build);
   OrientPieces(build);

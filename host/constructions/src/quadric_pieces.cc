@@ -81,7 +81,8 @@ class PieceDrawer {
   FDSURF_NODISCARD bool OvalInside(double h) const;
   FDSURF_NODISCARD bool OvalBelongs(double h) const;
   void SectionArcs(double h, std::vector<BranchArc>* out) const;
-  void Emit(const BranchArc& a, QuadricArc::Role role, int index, std::vector<QuadricArc>* out) const;
+  void Emit(const BranchArc& a, QuadricArc::Role role, int index,
+            std::vector<QuadricArc>* out) const;
 
   const PieceInput& in_;
   Point3 centroid_{};
@@ -204,9 +205,11 @@ void PieceDrawer::FindOutline(int k) {
     // Both trimming planes pass through the vertex they share; the curve
     // arrives there from the wrong side of the other one.
     const int vertex = left_plane == (k + 1) % 3 ? (k + 1) % 3 : k;
-    throw ConstructionError(EdgeName(k) + ": the quadric's curve in the edge's trimming plane "
-                            "leaves the trimming plane of edge " + std::to_string(left_plane) +
-                            " near its vertex " + std::to_string(vertex) +
+    throw ConstructionError(EdgeName(k) +
+                            ": the quadric's curve in the edge's trimming plane "
+                            "leaves the trimming plane of edge " +
+                            std::to_string(left_plane) + " near its vertex " +
+                            std::to_string(vertex) +
                             " (the glue planes around that vertex cross: choose a mu nearer the "
                             "normals' curvature, or refine the mesh)");
   }
@@ -336,7 +339,8 @@ void PieceDrawer::SectionArcs(double h, std::vector<BranchArc>* out) const {
       if (branch.Cyclic() && Inside(branch.At(0)) && OvalBelongs(h)) out->push_back({branch, 0, 0});
       continue;
     }
-    std::sort(breaks.begin(), breaks.end(), [](const Break& x, const Break& y) { return x.p < y.p; });
+    std::sort(breaks.begin(), breaks.end(),
+              [](const Break& x, const Break& y) { return x.p < y.p; });
     const std::size_t n = breaks.size();
     const std::size_t intervals = branch.Cyclic() ? n : n - 1;
     for (std::size_t i = 0; i < intervals; ++i) {
@@ -377,10 +381,12 @@ void PieceDrawer::Emit(const BranchArc& a, QuadricArc::Role role, int index,
         continue;
       }
       if (depth >= 24) {
-        throw ConstructionError(Name() + ": an arc's distance from the quadric cannot be bounded "
-                                         "within tolerance " +
-                                FormatNumber(in_.tolerance) + " (the quadric is nearly singular "
-                                                              "there)");
+        throw ConstructionError(Name() +
+                                ": an arc's distance from the quadric cannot be bounded "
+                                "within tolerance " +
+                                FormatNumber(in_.tolerance) +
+                                " (the quadric is nearly singular "
+                                "there)");
       }
       RationalQuadratic first;
       RationalQuadratic second;
@@ -451,8 +457,8 @@ double ArcDistanceBound(const RationalQuadratic& arc, const Quadric& f) {
   }
   m_norm = std::sqrt(m_norm);
   const Point3 middle = arc.At(0.5);
-  const double radius = std::max(
-      {Norm(Sub(arc.p0, middle)), Norm(Sub(arc.p1, middle)), Norm(Sub(arc.p2, middle))});
+  const double radius =
+      std::max({Norm(Sub(arc.p0, middle)), Norm(Sub(arc.p1, middle)), Norm(Sub(arc.p2, middle))});
   const double gamma = Norm(f.Gradient(middle)) * (1 - 1e-12) - 2 * m_norm * radius;
   if (!(gamma > 0) || 4 * epsilon * m_norm > gamma * gamma) {
     return std::numeric_limits<double>::infinity();

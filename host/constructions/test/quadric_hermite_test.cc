@@ -126,7 +126,9 @@ TEST(QuadricHermite, GluesAlongThePlaneXEqualsYAndReportsAContinuousJoin) {
     EXPECT_LE(r.bound, tolerance);
     ASSERT_FALSE(r.arcs.empty());
     for (const QuadricArc& arc : r.arcs) {
-      const auto f = [&](const Point3& x) { return arc.triangle == 1 ? Psi(x, 3 * a) / 3 : Phi(x, a); };
+      const auto f = [&](const Point3& x) {
+        return arc.triangle == 1 ? Psi(x, 3 * a) / 3 : Phi(x, a);
+      };
       const auto distance = [&](const Point3& x) {
         const double h = 1e-6;
         Point3 g{};

@@ -398,10 +398,12 @@ RandomQuadric MakeRandomQuadric(unsigned seed) {
   double q[4] = {unit(random), unit(random), unit(random), unit(random)};
   const double qn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   for (double& x : q) x /= qn;
-  const double r[3][3] = {
-      {1 - 2 * (q[2] * q[2] + q[3] * q[3]), 2 * (q[1] * q[2] - q[0] * q[3]), 2 * (q[1] * q[3] + q[0] * q[2])},
-      {2 * (q[1] * q[2] + q[0] * q[3]), 1 - 2 * (q[1] * q[1] + q[3] * q[3]), 2 * (q[2] * q[3] - q[0] * q[1])},
-      {2 * (q[1] * q[3] - q[0] * q[2]), 2 * (q[2] * q[3] + q[0] * q[1]), 1 - 2 * (q[1] * q[1] + q[2] * q[2])}};
+  const double r[3][3] = {{1 - 2 * (q[2] * q[2] + q[3] * q[3]), 2 * (q[1] * q[2] - q[0] * q[3]),
+                           2 * (q[1] * q[3] + q[0] * q[2])},
+                          {2 * (q[1] * q[2] + q[0] * q[3]), 1 - 2 * (q[1] * q[1] + q[3] * q[3]),
+                           2 * (q[2] * q[3] - q[0] * q[1])},
+                          {2 * (q[1] * q[3] - q[0] * q[2]), 2 * (q[2] * q[3] + q[0] * q[1]),
+                           1 - 2 * (q[1] * q[1] + q[2] * q[2])}};
   const Point3 shift{20 * unit(random), 20 * unit(random), 20 * unit(random)};
   // In the local frame: an ellipsoid, or z = (κ1·x² + κ2·y²)/2 over a grid.
   const bool closed = seed % 2 == 1;
@@ -415,7 +417,8 @@ RandomQuadric MakeRandomQuadric(unsigned seed) {
     for (int i = 0; i < 3; ++i) local_s[i][i] = 1 / (axes[i] * axes[i]);
     local_c = -1;
     const Mesh m = SphereMesh(1, 1);
-    for (const Point3& v : m.vertices) local_points.push_back({axes[0] * v[0], axes[1] * v[1], axes[2] * v[2]});
+    for (const Point3& v : m.vertices)
+      local_points.push_back({axes[0] * v[0], axes[1] * v[1], axes[2] * v[2]});
     triangles = m.triangles;
   } else {
     const double k1 = (0.5 + 0.5 * unit(random)) / 30;
@@ -470,7 +473,8 @@ RandomQuadric MakeRandomQuadric(unsigned seed) {
   // μ of G scaled as the seed scales F (∇F(P₁) = 2·A₁, |A₁| = 1).
   for (const auto& tri : out.mesh.triangles) {
     const Point3& p0 = out.mesh.vertices[tri[0]];
-    const Point3 n = Scale(Cross(Sub(out.mesh.vertices[tri[1]], p0), Sub(out.mesh.vertices[tri[2]], p0)), 1);
+    const Point3 n =
+        Scale(Cross(Sub(out.mesh.vertices[tri[1]], p0), Sub(out.mesh.vertices[tri[2]], p0)), 1);
     const Point3 unit_n = Scale(n, 1 / Norm(n));
     double form = 0;
     for (int i = 0; i < 3; ++i) {
@@ -512,8 +516,10 @@ TEST(QuadricMeshes, NormalsThatMissTheConditionsAreTurnedToTheNearestCompatibleO
     std::mt19937 random(seed);
     std::uniform_real_distribution<double> unit(-1, 1);
     QuadricMesh turned = g.mesh;
-    for (Point3& n : turned.normals) n = Add(n, {0.01 * unit(random), 0.01 * unit(random), 0.01 * unit(random)});
-    EXPECT_NE(ErrorOfBuild(turned).find("the linear conditions are inconsistent"), std::string::npos);
+    for (Point3& n : turned.normals)
+      n = Add(n, {0.01 * unit(random), 0.01 * unit(random), 0.01 * unit(random)});
+    EXPECT_NE(ErrorOfBuild(turned).find("the linear conditions are inconsistent"),
+              std::string::npos);
     turned.adjust_normals = true;
     const QuadricResult r = BuildQuadricMesh(turned, 1e-3, "turned");
     // Turned by about what they were tilted (up to 0.01·√3 rad ≈ 1°).

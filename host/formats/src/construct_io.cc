@@ -2,14 +2,14 @@
 #include "construct_io.h"
 
 #include <algorithm>
-#include <filesystem>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <initializer_list>
 
 #include "fdsurf/host/constructions.h"
-#include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/mesh_io.h"
+#include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quadric_hermite.h"
 #include "fdsurf/host/text.h"
 
@@ -412,7 +412,8 @@ void ParseMu(const json& e, const Place& place, QuadricMesh* mesh) {
   const json& mu = e["mu"];
   const Place mp = place.Child("mu");
   if (mu.is_string()) {
-    if (mu.get<std::string>() != "normals") throw mp.Error(R"(must be a number, an array or "normals")");
+    if (mu.get<std::string>() != "normals")
+      throw mp.Error(R"(must be a number, an array or "normals")");
     mesh->mu_from_normals = true;
   } else if (mu.is_number()) {
     mesh->mu = {mu.get<double>()};
@@ -424,7 +425,7 @@ void ParseMu(const json& e, const Place& place, QuadricMesh* mesh) {
 // Vertices, normals and triangles from the entry's own arrays.
 void ParseInlineMesh(const json& e, const Place& place, QuadricMesh* mesh) {
   for (const char* key : {"vertices", "normals", "triangles"}) {
-    if (!e.contains(key)) throw place.Error(std::string("missing \"") + key + "\" (or \"mesh\")");
+    if (!e.contains(key)) throw place.Error(std::string(R"(missing ")") + key + R"(" (or "mesh"))");
   }
   mesh->vertices = ParsePoints(e["vertices"], place.Child("vertices"), 3);
   mesh->normals = ParsePoints(e["normals"], place.Child("normals"), 3);
@@ -450,7 +451,8 @@ void ReadMeshField(const json& e, const Place& place, QuadricMesh* mesh, PatchSe
   if (e.contains("vertices") || e.contains("normals") || e.contains("triangles")) {
     throw place.Error(R"(give "mesh" or "vertices", "normals" and "triangles", not both)");
   }
-  if (!e["mesh"].is_string()) throw place.Child("mesh").Error("must be the path of an OBJ or PLY file");
+  if (!e["mesh"].is_string())
+    throw place.Child("mesh").Error("must be the path of an OBJ or PLY file");
   std::filesystem::path path = e["mesh"].get<std::string>();
   if (path.is_relative()) path = std::filesystem::path(place.file).parent_path() / path;
   TriangleMesh file = ReadMeshFile(path.string());
@@ -485,7 +487,8 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
     }
     mesh.sections = e["sections"].get<int>();
   }
-  if (e.contains("adjust_normals")) mesh.adjust_normals = Bool(e["adjust_normals"], place.Child("adjust_normals"));
+  if (e.contains("adjust_normals"))
+    mesh.adjust_normals = Bool(e["adjust_normals"], place.Child("adjust_normals"));
   const double tolerance = Tolerance(e, place, 1e-3);
   try {
     QuadricResult result = BuildQuadricMesh(mesh, tolerance, SegmentOrigin(place, 0, 1));

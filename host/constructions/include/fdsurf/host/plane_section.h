@@ -64,10 +64,10 @@ class SectionBranch {
   Point3 origin_{};
   Point3 e1_{};
   Point3 e2_{};
-  double quad_[3] = {};   // a, b, c
-  double k_[2] = {};      // K (conic) or the line's point
-  double grad_[2] = {};   // half the gradient of q at K: A·K + (d, e)
-  double dir_[2] = {};    // the line's direction
+  double quad_[3] = {};  // a, b, c
+  double k_[2] = {};     // K (conic) or the line's point
+  double grad_[2] = {};  // half the gradient of q at K: A·K + (d, e)
+  double dir_[2] = {};   // the line's direction
 };
 
 /// The section of quadric f by the plane through `origin` spanned by the

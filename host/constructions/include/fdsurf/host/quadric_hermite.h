@@ -169,7 +169,7 @@ struct QuadricResult {
 /// bad input: an edge of more than two triangles or two triangles that run
 /// along an edge the same way (naming the edge), and the cases of
 /// SolveQuadricTriangle (naming the triangle).
-QuadricResult BuildQuadricMesh(const QuadricMesh& mesh, double tolerance,
+QuadricResult BuildQuadricMesh(const QuadricMesh& mesh_in, double tolerance,
                                const std::string& origin);
 
 }  // namespace fdsurf::host
