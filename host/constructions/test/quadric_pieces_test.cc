@@ -259,16 +259,21 @@ bool InsidePlanes(const std::array<Plane, 3>& planes, const Point3& x, double sl
   return true;
 }
 
-// Every cubic point of every arc: on its quadric within the arc's bound
-// (by projection) and, so projected, inside its piece's planes.
+// Every cubic of every arc, at its ends and 16 random points: on its
+// quadric within the cubic's bound (by projection) and, so projected, inside
+// its piece's planes.
 void ExpectWithinProvenBound(const QuadricResult& r, double tolerance) {
   EXPECT_LE(r.bound, tolerance);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0, 1);
   for (const QuadricArc& arc : r.arcs) {
     const Quadric& f = r.pieces[arc.triangle].quadric;
     EXPECT_LE(arc.bound, tolerance);
     for (const CubicArc& cubic : arc.cubics) {
-      for (int i = 0; i <= 16; ++i) {
-        const Point3 x = CubicAt(cubic.b, i / 16.0);
+      // The ends, and random points between.
+      for (int i = 0; i <= 17; ++i) {
+        const double t = i == 0 ? 0 : i == 17 ? 1 : unit(random);
+        const Point3 x = CubicAt(cubic.b, t);
         const Point3 on = ProjectOnto(f, x);
         ASSERT_LT(std::fabs(f.Value(on)), 1e-9);
         EXPECT_LE(Norm(Sub(on, x)), cubic.bound) << "triangle " << arc.triangle;
