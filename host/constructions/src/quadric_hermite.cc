@@ -475,6 +475,37 @@ std::string EdgeName(int va, int vb) {
   return "the edge between vertices " + std::to_string(va) + " and " + std::to_string(vb);
 }
 
+// Every vertex's triangles must form one fan, joined through the edges at
+// the vertex: two fans meeting at a point pinch the surface there.
+void CheckVertexFans(const QuadricMesh& mesh,
+                     const std::map<std::pair<int, int>, std::vector<std::pair<int, int>>>& edges) {
+  // Per vertex, a union-find over its triangles.
+  std::vector<std::map<int, int>> parent(mesh.vertices.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int v : mesh.triangles[t]) parent[v][static_cast<int>(t)] = static_cast<int>(t);
+  }
+  const auto find = [&](std::map<int, int>& p, int x) {
+    while (p[x] != x) x = p[x] = p[p[x]];
+    return x;
+  };
+  for (const auto& [key, users] : edges) {
+    if (users.size() != 2) continue;
+    for (int v : {key.first, key.second}) {
+      parent[v][find(parent[v], users[0].first)] = find(parent[v], users[1].first);
+    }
+  }
+  for (std::size_t v = 0; v < parent.size(); ++v) {
+    int fans = 0;
+    for (const auto& [t, up] : parent[v]) fans += t == up ? 1 : 0;
+    if (fans > 1) {
+      throw ConstructionError("vertex " + std::to_string(v) + ": its triangles form " +
+                              std::to_string(fans) +
+                              " separate fans that meet only there (the mesh is pinched: not a "
+                              "manifold)");
+    }
+  }
+}
+
 // Stage 3: the mesh's edges (each in at most two triangles, run in opposite
 // directions by them), and for each shared edge the glue plane.
 void FindGlues(QuadricBuild& b) {
@@ -488,6 +519,14 @@ void FindGlues(QuadricBuild& b) {
       edges[{std::min(va, vb), std::max(va, vb)}].emplace_back(static_cast<int>(t), k);
     }
   }
+  for (const auto& [key, users] : edges) {
+    if (users.size() > 2) {
+      throw ConstructionError(EdgeName(key.first, key.second) + " belongs to " +
+                              std::to_string(users.size()) +
+                              " triangles (at most 2: the mesh is not a manifold)");
+    }
+  }
+  CheckVertexFans(mesh, edges);
   b.neighbour.assign(mesh.triangles.size(), {-1, -1, -1});
   b.glue_of.assign(mesh.triangles.size(), {-1, -1, -1});
   for (const auto& [key, users] : edges) {
@@ -689,8 +728,10 @@ std::vector<std::pair<int, int>> EdgesOf(const QuadricMesh& mesh) {
 // The edge rows B of N's equations (g_i + g_j)·u_ij = 0 (u_ij the unit edge
 // direction, so that every edge weighs the same), applied by conjugate
 // gradients to find y with (B·Bᵀ)·y = B·a: then a − Bᵀ·y is the nearest
-// field in N to a. Returns Bᵀ·y.
-std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vector<Point3>& a) {
+// field in N to a. Returns Bᵀ·y, and in *residual the largest |B·(a − Bᵀ·y)|
+// per edge (0 up to rounding once converged).
+std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vector<Point3>& a,
+                                         double* residual) {
   const std::vector<std::pair<int, int>> edges = EdgesOf(mesh);
   std::vector<Point3> dir;
   dir.reserve(edges.size());
@@ -710,13 +751,17 @@ std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vec
     }
     return out;
   };
+  // Conjugate gradients. The floor is relative to the start and absolute:
+  // rows are unit-scaled, so 1e-14 per edge is rounding, and running on
+  // below it only amplifies rounding (normals already compatible start
+  // there).
   std::vector<double> y(edges.size(), 0.0);
   std::vector<double> r = times(a);
   std::vector<double> d = r;
   double rr = 0;
   for (double v : r) rr += v * v;
-  const double start = rr;
-  for (std::size_t it = 0; it < 20 * edges.size() + 100 && rr > 1e-30 * start; ++it) {
+  const double floor = std::max(1e-30 * rr, 1e-28 * static_cast<double>(edges.size()));
+  for (std::size_t it = 0; it < 20 * edges.size() + 100 && rr > floor; ++it) {
     const std::vector<double> ad = times(transpose_times(d));
     double dad = 0;
     for (std::size_t k = 0; k < d.size(); ++k) dad += d[k] * ad[k];
@@ -731,7 +776,13 @@ std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vec
     for (std::size_t k = 0; k < d.size(); ++k) d[k] = r[k] + (next / rr) * d[k];
     rr = next;
   }
-  return transpose_times(y);
+  // What is left of B·g, g = a − Bᵀ·y: 0 once the projection has converged.
+  std::vector<Point3> g = a;
+  const std::vector<Point3> correction = transpose_times(y);
+  for (std::size_t v = 0; v < g.size(); ++v) g[v] = Sub(g[v], correction[v]);
+  *residual = 0;
+  for (double left : times(g)) *residual = std::max(*residual, std::fabs(left));
+  return correction;
 }
 
 // The seed's conditions on a triangle have a solution only when its normals
@@ -749,7 +800,15 @@ std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_d
   std::vector<Point3> a;
   a.reserve(mesh.normals.size());
   for (const Point3& n : mesh.normals) a.push_back(Unit(n));
-  const std::vector<Point3> correction = ProjectionCorrection(mesh, a);
+  double residual = 0;
+  const std::vector<Point3> correction = ProjectionCorrection(mesh, a, &residual);
+  // Thin triangles make B·Bᵀ ill-conditioned; a projection that stopped
+  // short is said so, not passed on to be refused as "inconsistent".
+  const bool converged = residual <= 1e-9;
+  const std::string unconverged =
+      converged ? ""
+                : " (the projection stopped short, with " + FormatNumber(residual, 3) +
+                      " left per edge: thin triangles make it ill-conditioned)";
   std::vector<Point3> g(a.size());
   *largest_turn_deg = 0;
   double total_turn = 0;
@@ -768,10 +827,13 @@ std::vector<Point3> CompatibleNormals(const QuadricMesh& mesh, double max_turn_d
     throw ConstructionError(
         "the normals would have to turn by up to " + FormatNumber(*largest_turn_deg, 3) +
         " degrees (" + FormatNumber(total_turn / static_cast<double>(a.size()), 3) +
-        " on average) for every triangle's conditions to have a solution; more than " +
-        FormatNumber(max_turn_deg) +
+        " on average) for every triangle's conditions to have a solution" + unconverged +
+        "; more than " + FormatNumber(max_turn_deg) +
         " changes the surface, so it is refused (these vertices do not lie near a surface whose "
         "pieces are quadrics meeting this way: see docs/constructions.md, \"Compatible normals\")");
+  }
+  if (!converged) {
+    throw ConstructionError("the nearest compatible normals could not be found" + unconverged);
   }
   return g;
 }
