@@ -361,7 +361,7 @@ TEST(QuadricMeshes, MuBendsThePiecesButKeepsTheVerticesAndNormals) {
   }
 }
 
-std::string ErrorOfBuild(const QuadricMesh& mesh) {
+std::string ErrorOf(const QuadricMesh& mesh) {
   try {
     BuildQuadricMesh(mesh, 1e-3, "q");
   } catch (const ConstructionError& e) {
@@ -535,7 +535,7 @@ TEST(QuadricMeshes, NormalsThatMissTheConditionsAreTurnedToTheNearestCompatibleO
     QuadricMesh turned = g.mesh;
     for (Point3& n : turned.normals)
       n = Add(n, {0.01 * unit(random), 0.01 * unit(random), 0.01 * unit(random)});
-    EXPECT_NE(ErrorOfBuild(turned).find("the linear conditions are inconsistent"),
+    EXPECT_NE(ErrorOf(turned).find("the linear conditions are inconsistent"),
               std::string::npos);
     turned.adjust_normals = true;
     const QuadricResult r = BuildQuadricMesh(turned, 1e-3, "turned");
@@ -649,15 +649,6 @@ TEST(QuadricMeshes, ARealMeshFarFromQuadricPiecesIsRefusedWithTheTurnItWouldNeed
               std::string::npos)
         << e.what();
   }
-}
-
-std::string ErrorOf(const QuadricMesh& mesh) {
-  try {
-    BuildQuadricMesh(mesh, 1e-3, "q");
-  } catch (const ConstructionError& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 TEST(QuadricMeshes, RefusesNonManifoldMeshesUnboundedPiecesAndConflictingParameters) {
