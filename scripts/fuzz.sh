@@ -9,7 +9,7 @@
 #
 #   bash scripts/fuzz.sh [SECONDS_PER_TARGET]
 #
-# Environment: FDSURF_FUZZ_TARGETS (default: all four), FDSURF_FUZZ_JOBS
+# Environment: FDSURF_FUZZ_TARGETS (default: all five), FDSURF_FUZZ_JOBS
 # (parallel libFuzzer jobs per target, default 1), FDSURF_FUZZ_KEEP (a
 # directory to keep the grown corpora and artifacts in instead of a
 # temporary one), FDSURF_FUZZ_KNOWN_DEFECTS (device_harness.h: report the
@@ -17,15 +17,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-targets=${FDSURF_FUZZ_TARGETS:-fuzz_bpt fuzz_json fuzz_device_bytes fuzz_device_frames}
+targets=${FDSURF_FUZZ_TARGETS:-fuzz_bpt fuzz_json fuzz_mesh fuzz_device_bytes fuzz_device_frames}
 jobs=${FDSURF_FUZZ_JOBS:-1}
 build=build-fuzz
 
-# The largest input per target: text files of a few patches, a few frames'
-# worth of link bytes, a few dozen host actions.
+# The largest input per target: text files of a few patches or a few dozen
+# triangles, a few frames' worth of link bytes, a few dozen host actions.
 max_len() {
   case $1 in
-    fuzz_bpt | fuzz_json) echo 4096 ;;
+    fuzz_bpt | fuzz_json | fuzz_mesh) echo 4096 ;;
     fuzz_device_bytes) echo 2048 ;;
     fuzz_device_frames) echo 1024 ;;
   esac
