@@ -241,9 +241,6 @@ TEST_F(MeshCli, PlotOfAPerturbedOctahedronFailsTheExtentCheck) {
 // samples per curve, host::ReferenceLines), which the sanitizer build runs
 // some 80 times slower: there the test is skipped (tests/CMakeLists.txt).
 TEST_F(MeshCli, StreamOfTheOctahedronDrawsTheSpheresDiscOnTheSimulatedPlotter) {
-#ifdef FDSURF_MESH_CLI_SKIP_STREAM
-  GTEST_SKIP() << "some 12 minutes under the sanitizers";
-#endif
   const std::string json =
       Write("octahedron.json", R"({"units": "mm", "construct": [{"type": "quadric-hermite", )"
                                R"("mesh": ")" +

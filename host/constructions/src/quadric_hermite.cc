@@ -271,12 +271,36 @@ std::string PieceNote(const std::string& origin, const std::string& name, const 
   }
   note += "; mu = " + FormatNumber(piece.mu);
   const auto& m = piece.quadric.m;
-  note += "; F = " + FormatNumber(m[0][0]) + "·dx² + " + FormatNumber(m[1][1]) + "·dy² + " +
-          FormatNumber(m[2][2]) + "·dz² + " + FormatNumber(2 * m[0][1]) + "·dx·dy + " +
-          FormatNumber(2 * m[0][2]) + "·dx·dz + " + FormatNumber(2 * m[1][2]) + "·dy·dz + 2·(" +
-          FormatNumber(a1[0]) + "·dx + " + FormatNumber(a1[1]) + "·dy + " + FormatNumber(a1[2]) +
-          "·dz), d = X − vertex " + std::to_string(first_vertex);
+  // Terms with their own signs; coefficients below 1e-12 of the largest are
+  // rounding (a sphere's cross terms come out as 1e-18) and left out.
+  const double terms[9] = {m[0][0],     m[1][1],   m[2][2],   2 * m[0][1], 2 * m[0][2],
+                           2 * m[1][2], 2 * a1[0], 2 * a1[1], 2 * a1[2]};
+  static const char* const kNames[9] = {"dx²",   "dy²", "dz²", "dx·dy", "dx·dz",
+                                        "dy·dz", "dx",  "dy",  "dz"};
+  double largest = 0;
+  for (double v : terms) largest = std::max(largest, std::fabs(v));
+  std::string f;
+  for (int k = 0; k < 9; ++k) {
+    if (std::fabs(terms[k]) <= 1e-12 * largest) continue;
+    f += f.empty() ? (terms[k] < 0 ? "-" : "") : (terms[k] < 0 ? " - " : " + ");
+    f += FormatNumber(std::fabs(terms[k])) + "·" + kNames[k];
+  }
+  note += "; F = " + (f.empty() ? std::string("0") : f) + ", d = X − vertex " +
+          std::to_string(first_vertex);
   return note;
+}
+
+// The free unknowns' values when "free" does not give them: 0 for the
+// quadric's coefficients (the seed's choice), and for a free λ_i (a flat
+// triangle whose normals are parallel leaves them free) the value of the
+// plane F = 2·A₁·D, whose gradient 2·A₁ is λ_i·Â_i: λ_i = 2·A₁·Â_i. Zero
+// there would make the gradient vanish at that vertex.
+std::vector<double> DefaultFree(const QuadricSolution& solution, const std::array<Point3, 3>& n) {
+  std::vector<double> values;
+  for (int unknown : solution.free_unknowns) {
+    values.push_back(unknown >= 6 ? 2 * Dot(n[0], Unit(n[unknown - 5])) : 0.0);
+  }
+  return values;
 }
 
 // μ from the normals: |A₁| times the mean over the edges of the normal
@@ -328,7 +352,7 @@ void SolvePieces(QuadricBuild& b) {
                               ": give either \"free\" or \"mu\": both choose the one free "
                               "parameter");
     }
-    piece.parameters = mesh.free.empty() ? std::vector<double>(free_count, 0.0) : mesh.free[t];
+    piece.parameters = mesh.free.empty() ? DefaultFree(piece.solution, n) : mesh.free[t];
     piece.quadric = piece.solution.With(piece.parameters);
     piece.plane_normal = Unit(Cross(Sub(p[1], p[0]), Sub(p[2], p[0])));
     if (mu_given) {
@@ -475,10 +499,24 @@ std::string EdgeName(int va, int vb) {
   return "the edge between vertices " + std::to_string(va) + " and " + std::to_string(vb);
 }
 
+// (lower vertex, higher vertex) -> (triangle, edge k) of the edge's users.
+using EdgeUsers = std::map<std::pair<int, int>, std::vector<std::pair<int, int>>>;
+
+EdgeUsers EdgeUsersOf(const QuadricMesh& mesh) {
+  EdgeUsers edges;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int va = mesh.triangles[t][k];
+      const int vb = mesh.triangles[t][(k + 1) % 3];
+      edges[{std::min(va, vb), std::max(va, vb)}].emplace_back(static_cast<int>(t), k);
+    }
+  }
+  return edges;
+}
+
 // Every vertex's triangles must form one fan, joined through the edges at
 // the vertex: two fans meeting at a point pinch the surface there.
-void CheckVertexFans(const QuadricMesh& mesh,
-                     const std::map<std::pair<int, int>, std::vector<std::pair<int, int>>>& edges) {
+void CheckVertexFans(const QuadricMesh& mesh, const EdgeUsers& edges) {
   // Per vertex, a union-find over its triangles.
   std::vector<std::map<int, int>> parent(mesh.vertices.size());
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -506,43 +544,40 @@ void CheckVertexFans(const QuadricMesh& mesh,
   }
 }
 
-// Stage 3: the mesh's edges (each in at most two triangles, run in opposite
-// directions by them), and for each shared edge the glue plane.
-void FindGlues(QuadricBuild& b) {
-  const QuadricMesh& mesh = b.mesh;
-  // (lower vertex, higher vertex) -> (triangle, edge k) of its users.
-  std::map<std::pair<int, int>, std::vector<std::pair<int, int>>> edges;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const int va = mesh.triangles[t][k];
-      const int vb = mesh.triangles[t][(k + 1) % 3];
-      edges[{std::min(va, vb), std::max(va, vb)}].emplace_back(static_cast<int>(t), k);
-    }
-  }
+// Before anything is solved: every edge in at most two triangles, run in
+// opposite directions by them, and every vertex's triangles one fan.
+void CheckTopology(const QuadricMesh& mesh) {
+  const EdgeUsers edges = EdgeUsersOf(mesh);
   for (const auto& [key, users] : edges) {
     if (users.size() > 2) {
       throw ConstructionError(EdgeName(key.first, key.second) + " belongs to " +
                               std::to_string(users.size()) +
                               " triangles (at most 2: the mesh is not a manifold)");
+    }
+  }
+  for (const auto& [key, users] : edges) {
+    if (users.size() == 2 && mesh.triangles[users[0].first][users[0].second] ==
+                                 mesh.triangles[users[1].first][users[1].second]) {
+      throw ConstructionError(EdgeName(key.first, key.second) + ": triangles " +
+                              std::to_string(users[0].first) + " and " +
+                              std::to_string(users[1].first) +
+                              " run along it in the same direction (inconsistent orientation)");
     }
   }
   CheckVertexFans(mesh, edges);
+}
+
+// Stage 3: for each shared edge the glue plane (the topology was checked
+// first).
+void FindGlues(QuadricBuild& b) {
+  const QuadricMesh& mesh = b.mesh;
+  const EdgeUsers edges = EdgeUsersOf(mesh);
   b.neighbour.assign(mesh.triangles.size(), {-1, -1, -1});
   b.glue_of.assign(mesh.triangles.size(), {-1, -1, -1});
   for (const auto& [key, users] : edges) {
-    if (users.size() > 2) {
-      throw ConstructionError(EdgeName(key.first, key.second) + " belongs to " +
-                              std::to_string(users.size()) +
-                              " triangles (at most 2: the mesh is not a manifold)");
-    }
     if (users.size() < 2) continue;
     const auto [t1, k1] = users[0];
     const auto [t2, k2] = users[1];
-    if (mesh.triangles[t1][k1] == mesh.triangles[t2][k2]) {
-      throw ConstructionError(EdgeName(key.first, key.second) + ": triangles " +
-                              std::to_string(t1) + " and " + std::to_string(t2) +
-                              " run along it in the same direction (inconsistent orientation)");
-    }
     b.neighbour[t1][k1] = t2;
     b.neighbour[t2][k2] = t1;
     const EdgePair pair(b.result.pieces[t1].quadric, b.result.pieces[t2].quadric,
@@ -844,20 +879,23 @@ QuadricResult BuildQuadricMesh(const QuadricMesh& mesh_in, double tolerance,
                                const std::string& origin) {
   ValidateMesh(mesh_in);
   if (!(tolerance > 0)) throw ConstructionError("the tolerance must be positive");
+  for (std::size_t t = 0; t < mesh_in.triangles.size(); ++t) {
+    CheckTriangleIndices(mesh_in, mesh_in.triangles[t], "triangles[" + std::to_string(t) + "]");
+  }
+  CheckTopology(mesh_in);
   QuadricMesh mesh = mesh_in;
   double turn = 0;
   if (mesh_in.adjust_normals) {
-    for (std::size_t t = 0; t < mesh_in.triangles.size(); ++t) {
-      CheckTriangleIndices(mesh_in, mesh_in.triangles[t], "triangles[" + std::to_string(t) + "]");
-    }
     mesh.normals = CompatibleNormals(mesh_in, mesh_in.max_normal_turn_deg, &turn);
   }
   QuadricBuild build{mesh, tolerance, origin, {}, {}, {}, {}};
   if (mesh_in.adjust_normals) {
     build.result.normals = mesh.normals;
     build.result.largest_normal_turn_deg = turn;
-    build.result.notes.push_back(origin + ": normals turned by up to " + FormatNumber(turn) +
-                                 " degrees so that every triangle's conditions have a solution");
+    build.result.notes.push_back(
+        turn < 1e-9 ? origin + ": the normals are compatible as given"
+                    : origin + ": normals turned by up to " + FormatNumber(turn) +
+                          " degrees so that every triangle's conditions have a solution");
   }
   SolvePieces(build);
   OrientPieces(build);

@@ -651,6 +651,27 @@ TEST(QuadricMeshes, ARealMeshFarFromQuadricPiecesIsRefusedWithTheTurnItWouldNeed
   }
 }
 
+TEST(QuadricMeshes, AFlatRegionIsDrawnAsItsPlane) {
+  // Two coplanar triangles with the plane's normal: rank 5, λ₂ and λ₃ free;
+  // they default to the plane's (2·A₁·Â_i), not to 0 (a zero gradient).
+  QuadricMesh flat;
+  flat.vertices = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {10, 10, 0}};
+  flat.normals.assign(4, {0, 0, 1});
+  flat.triangles = {{0, 1, 3}, {0, 3, 2}};
+  flat.mu_from_normals = true;
+  const QuadricResult r = BuildQuadricMesh(flat, 1e-3, "flat");
+  for (const QuadricPiece& piece : r.pieces) {
+    EXPECT_EQ(piece.solution.rank, 5);
+    EXPECT_NEAR(piece.quadric.Value({3, 4, 1}), 2, 1e-12);  // F = 2z
+  }
+  // The outline only (sections parallel to a plane piece are empty), the
+  // shared diagonal once: 5 segments, all in z = 0.
+  EXPECT_EQ(r.curves.size(), 5u);
+  for (const Curve& c : r.curves) {
+    for (const Point3& p : c.g) EXPECT_NEAR(p[2], 0, 1e-12);
+  }
+}
+
 TEST(QuadricMeshes, RefusesNonManifoldMeshesUnboundedPiecesAndConflictingParameters) {
   // Two octahedra sharing only vertex 0: two fans of triangles there.
   QuadricMesh pinched = RadialMesh(SphereMesh(50, 0));

@@ -470,6 +470,10 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
   QuadricMesh mesh;
   if (e.contains("mesh")) {
     ReadMeshField(e, place, &mesh, set);
+    // A mesh file's normals rarely fit the seed's conditions as they are:
+    // the same defaults as the file given to the tool directly.
+    mesh.mu_from_normals = !e.contains("mu") && !e.contains("free");
+    mesh.adjust_normals = true;
   } else {
     ParseInlineMesh(e, place, &mesh);
   }
@@ -528,7 +532,8 @@ PatchSet MeshFileAsPatchSet(const std::string& path) {
     set.curves = std::move(result.curves);
     for (std::string& note : result.notes) set.notes.push_back(std::move(note));
   } catch (const ConstructionError& error) {
-    throw InputError(path + ": " + error.what());
+    throw InputError(path + ": " + error.what() +
+                     " (vertices and triangles are counted from 0, in file order)");
   }
   return set;
 }

@@ -375,6 +375,38 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   return job;
 }
 
+namespace {
+
+// The polyline of u ↦ at(u), u ∈ [0, 1], in steps: subdivided until each
+// chord is within chord_steps of the curve at its midpoint and quarter points
+// and at most 8 steps long (a cubic piece this short has no room for an
+// undetected bulge).
+template <typename At>
+std::vector<Vec> RefinedPolyline(const At& at, double chord_steps) {
+  std::vector<Vec> points{at(0)};
+  std::function<void(double, const Vec&, double, const Vec&, int)> refine =
+      [&](double u0, const Vec& p0, double u1, const Vec& p1, int depth) {
+        const Vec mid = at((u0 + u1) / 2);
+        double worst = 0;
+        for (const double f : {0.25, 0.5, 0.75}) {
+          const Vec q = f == 0.5 ? mid : at(u0 + f * (u1 - u0));
+          Vec chord{};
+          for (int c = 0; c < 3; ++c) chord[c] = p0[c] + f * (p1[c] - p0[c]);
+          worst = std::max(worst, Distance(q, chord));
+        }
+        if (depth < 24 && (worst > chord_steps || Distance(p0, p1) > 8)) {
+          refine(u0, p0, (u0 + u1) / 2, mid, depth + 1);
+          refine((u0 + u1) / 2, mid, u1, p1, depth + 1);
+        } else {
+          points.push_back(p1);
+        }
+      };
+  refine(0, points[0], 1, at(1), 0);
+  return points;
+}
+
+}  // namespace
+
 std::vector<std::vector<std::array<double, 3>>> ReferenceLines(const PatchSet& set,
                                                                const StreamJob& job,
                                                                double chord_steps) {
@@ -387,28 +419,7 @@ std::vector<std::vector<std::array<double, 3>>> ReferenceLines(const PatchSet& s
         const auto at = [&](double u) {
           return s_lines ? InSteps(patch, job, fixed, u) : InSteps(patch, job, u, fixed);
         };
-        std::vector<Vec> points{at(0)};
-        // Subdivide until the chord is within chord_steps of the curve at the
-        // midpoint and the quarter points (a cubic piece this short has no
-        // room for an undetected bulge).
-        std::function<void(double, const Vec&, double, const Vec&, int)> refine =
-            [&](double u0, const Vec& p0, double u1, const Vec& p1, int depth) {
-              const Vec mid = at((u0 + u1) / 2);
-              double worst = 0;
-              for (const double f : {0.25, 0.5, 0.75}) {
-                const Vec q = f == 0.5 ? mid : at(u0 + f * (u1 - u0));
-                Vec chord{};
-                for (int c = 0; c < 3; ++c) chord[c] = p0[c] + f * (p1[c] - p0[c]);
-                worst = std::max(worst, Distance(q, chord));
-              }
-              if (depth < 24 && (worst > chord_steps || Distance(p0, p1) > 8)) {
-                refine(u0, p0, (u0 + u1) / 2, mid, depth + 1);
-                refine((u0 + u1) / 2, mid, u1, p1, depth + 1);
-              } else {
-                points.push_back(p1);
-              }
-            };
-        refine(0, points[0], 1, at(1), 0);
+        std::vector<Vec> points = RefinedPolyline(at, chord_steps);
         double length = 0;
         for (std::size_t k = 1; k < points.size(); ++k)
           length += Distance(points[k - 1], points[k]);
@@ -418,14 +429,11 @@ std::vector<std::vector<std::array<double, 3>>> ReferenceLines(const PatchSet& s
     add_family(streamed.lines_s, true);
     add_family(streamed.lines_t, false);
   }
+  // The curves the same way (they were sampled at 20,000 points each, which
+  // made the comparison of a mesh's thousands of short curves slow).
   for (const std::size_t c : job.curves) {
-    std::vector<Vec> points;
-    constexpr int kSamples = 20000;
-    for (int k = 0; k <= kSamples; ++k) {
-      points.push_back(
-          ToSteps(EvaluateCurve(set.curves[c], static_cast<double>(k) / kSamples), job));
-    }
-    lines.push_back(std::move(points));
+    const auto at = [&](double u) { return ToSteps(EvaluateCurve(set.curves[c], u), job); };
+    lines.push_back(RefinedPolyline(at, chord_steps));
   }
   return lines;
 }
