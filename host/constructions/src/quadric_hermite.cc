@@ -639,6 +639,7 @@ void DrawPieces(QuadricBuild& b) {
     internal::PieceInput in;
     in.f = &b.result.pieces[t].quadric;
     in.triangle = static_cast<int>(t);
+    in.vertex_ids = mesh.triangles[t];
     in.p = b.maps[t].p;
     in.planes = b.result.planes[t];
     in.n = b.result.pieces[t].plane_normal;
@@ -813,7 +814,7 @@ std::vector<Point3> ProjectionCorrection(const QuadricMesh& mesh, const std::vec
   }
   // What is left of B·g, g = a − Bᵀ·y: 0 once the projection has converged.
   std::vector<Point3> g = a;
-  const std::vector<Point3> correction = transpose_times(y);
+  std::vector<Point3> correction = transpose_times(y);
   for (std::size_t v = 0; v < g.size(); ++v) g[v] = Sub(g[v], correction[v]);
   *residual = 0;
   for (double left : times(g)) *residual = std::max(*residual, std::fabs(left));

@@ -59,9 +59,10 @@ class PieceDrawer {
   std::vector<QuadricArc> Draw();
 
  private:
-  FDSURF_NODISCARD std::string Name() const { return "triangle " + std::to_string(in_.triangle); }
+  // The caller names the triangle; this names its edge by the mesh's vertices.
   FDSURF_NODISCARD std::string EdgeName(int k) const {
-    return Name() + " edge " + std::to_string(k);
+    return "the edge from vertex " + std::to_string(in_.vertex_ids[k]) + " to vertex " +
+           std::to_string(in_.vertex_ids[(k + 1) % 3]);
   }
   FDSURF_NODISCARD bool Inside(const Point3& x, int except = -1) const {
     for (int k = 0; k < 3; ++k) {
@@ -206,10 +207,10 @@ void PieceDrawer::FindOutline(int k) {
     // arrives there from the wrong side of the other one.
     const int vertex = left_plane == (k + 1) % 3 ? (k + 1) % 3 : k;
     throw ConstructionError(EdgeName(k) +
-                            ": the quadric's curve in the edge's trimming plane "
-                            "leaves the trimming plane of edge " +
-                            std::to_string(left_plane) + " near its vertex " +
-                            std::to_string(vertex) +
+                            ": the quadric's curve in the edge's trimming plane leaves the "
+                            "trimming plane of " +
+                            EdgeName(left_plane) + " near vertex " +
+                            std::to_string(in_.vertex_ids[vertex]) +
                             " (the glue planes around that vertex cross: choose a mu nearer the "
                             "normals' curvature, or refine the mesh)");
   }
@@ -381,12 +382,12 @@ void PieceDrawer::Emit(const BranchArc& a, QuadricArc::Role role, int index,
         continue;
       }
       if (depth >= 24) {
-        throw ConstructionError(Name() +
-                                ": an arc's distance from the quadric cannot be bounded "
-                                "within tolerance " +
-                                FormatNumber(in_.tolerance) +
-                                " (the quadric is nearly singular "
-                                "there)");
+        throw ConstructionError(
+            "an arc's distance from the quadric cannot be bounded "
+            "within tolerance " +
+            FormatNumber(in_.tolerance) +
+            " (the quadric is nearly singular "
+            "there)");
       }
       RationalQuadratic first;
       RationalQuadratic second;

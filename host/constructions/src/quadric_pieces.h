@@ -17,6 +17,8 @@ namespace fdsurf::host::internal {
 struct PieceInput {
   const Quadric* f = nullptr;
   int triangle = 0;
+  /// The mesh's numbers of the triangle's vertices, for messages.
+  std::array<int, 3> vertex_ids{};
   /// The triangle's vertices; edge k runs from p[k] to p[(k + 1) % 3].
   std::array<Point3, 3> p{};
   /// The trimming plane of each edge, Side > 0 towards the third vertex.

@@ -535,8 +535,7 @@ TEST(QuadricMeshes, NormalsThatMissTheConditionsAreTurnedToTheNearestCompatibleO
     QuadricMesh turned = g.mesh;
     for (Point3& n : turned.normals)
       n = Add(n, {0.01 * unit(random), 0.01 * unit(random), 0.01 * unit(random)});
-    EXPECT_NE(ErrorOf(turned).find("the linear conditions are inconsistent"),
-              std::string::npos);
+    EXPECT_NE(ErrorOf(turned).find("the linear conditions are inconsistent"), std::string::npos);
     turned.adjust_normals = true;
     const QuadricResult r = BuildQuadricMesh(turned, 1e-3, "turned");
     // Turned by about what they were tilted (up to 0.01·√3 rad ≈ 1°).
@@ -722,7 +721,8 @@ TEST(QuadricMeshes, RefusesNonManifoldMeshesUnboundedPiecesAndConflictingParamet
   seed.triangles = {{0, 1, 2}, {3, 1, 0}};
   seed.free = {{-0.125}, {-0.375}};
   EXPECT_EQ(ErrorOf(seed),
-            "triangles[0]: triangle 0 edge 0: the quadric's curve in the edge's trimming plane "
+            "triangles[0]: the edge from vertex 0 to vertex 1: the quadric's curve in the edge's "
+            "trimming plane "
             "does not run from vertex to vertex without passing through infinity (the piece is "
             "unbounded)");
 }
