@@ -14,48 +14,19 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/reference.h"
 
+#include "tool_run.h"
+
 namespace fdsurf::host {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code;
-  std::string out;
-  std::string err;
-};
+using fdsurf::test_support::RunResult;
+using fdsurf::test_support::Slurp;
 
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class Cli : public ::testing::Test {
+class Cli : public fdsurf::test_support::ToolTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("fdsurf_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  RunResult Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout";
-    const fs::path err = dir_ / "stderr";
-    const std::string command = std::string("'") + FDSURF_BINARY + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
-  }
-
-  std::string Write(const std::string& name, const std::string& text) {
-    const fs::path path = dir_ / name;
-    std::ofstream(path) << text;
-    return path.string();
-  }
+  Cli() : ToolTest("fdsurf_cli_") {}
 
   // Asserts the contract for bad input.
   void ExpectRefused(const std::string& args, const std::string& stderr_part) {
@@ -65,8 +36,6 @@ class Cli : public ::testing::Test {
     EXPECT_NE(r.err.find(stderr_part), std::string::npos)
         << args << "\nstderr: " << r.err << "\nwanted: " << stderr_part;
   }
-
-  fs::path dir_;
 };
 
 const std::string kTeapot = FDSURF_EXAMPLES_DIR "/teapot.bpt";

@@ -18,52 +18,23 @@
 #include <string>
 #include <vector>
 
+#include "tool_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
 constexpr double kPi = 3.14159265358979323846;
 
-struct RunResult {
-  int exit_code;
-  std::string out;
-  std::string err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using fdsurf::test_support::RunResult;
+using fdsurf::test_support::Slurp;
 
 const std::string kExamples = FDSURF_EXAMPLES_DIR;
 const std::string kOctahedron = kExamples + "/octahedron.obj";
 
-class MeshCli : public ::testing::Test {
+class MeshCli : public fdsurf::test_support::ToolTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("fdsurf_mesh_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  RunResult Run(const std::string& args) {
-    const fs::path out = dir_ / "stdout";
-    const fs::path err = dir_ / "stderr";
-    const std::string command = std::string("'") + FDSURF_BINARY + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(command.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
-  }
-
-  std::string Write(const std::string& name, const std::string& bytes) {
-    const fs::path path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << bytes;
-    return path.string();
-  }
+  MeshCli() : ToolTest("fdsurf_mesh_cli_") {}
 
   // Bad input: exit code 2, nothing on stdout, `part` on stderr.
   void ExpectRefused(const std::string& args, const std::string& part) {
@@ -84,8 +55,6 @@ class MeshCli : public ::testing::Test {
     EXPECT_FALSE(fs::exists(svg));
     ExpectRefused("stream " + quoted, part);
   }
-
-  fs::path dir_;
 };
 
 // The points of an SVG drawing, in page units with y up (the writers' SVG is
