@@ -17,6 +17,7 @@
 
 #include "fdsurf/host/errors.h"
 #include "fdsurf/host/mesh_io.h"
+#include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quadric_hermite.h"
 #include "patch_check.h"
 
@@ -72,28 +73,12 @@ void CheckMesh(const TriangleMesh& mesh, const std::string& name) {
   }
 }
 
-// As MeshFileAsPatchSet: mu from the normals, normals turned where needed,
-// a tolerance of 1e-4 of the largest extent.
+// As MeshFileAsPatchSet draws it (MeshFileConstruction), with fewer sections.
 void CheckConstruction(const TriangleMesh& file, const std::string& name) {
   if (file.triangles.size() > kMaxBuiltTriangles) return;
-  fdsurf::host::QuadricMesh mesh;
-  mesh.vertices = file.vertices;
-  mesh.normals = file.normals;
-  mesh.triangles = file.triangles;
-  mesh.mu_from_normals = true;
-  mesh.adjust_normals = true;
+  double tolerance = 0;  // zero for a mesh of one point: the construction refuses it
+  fdsurf::host::QuadricMesh mesh = fdsurf::host::MeshFileConstruction(file, &tolerance);
   mesh.sections = kSections;
-  Point3 lo = mesh.vertices.front();
-  Point3 hi = lo;
-  for (const Point3& v : mesh.vertices) {
-    for (int c = 0; c < 3; ++c) {
-      lo[c] = std::min(lo[c], v[c]);
-      hi[c] = std::max(hi[c], v[c]);
-    }
-  }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  // Zero for a mesh of one point: the construction refuses it.
-  const double tolerance = 1e-4 * extent;
   fdsurf::host::QuadricResult result;
   try {
     result = fdsurf::host::BuildQuadricMesh(mesh, tolerance, name + ": quadric-hermite");

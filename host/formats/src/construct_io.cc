@@ -456,10 +456,12 @@ void ReadMeshField(const json& e, const Place& place, QuadricMesh* mesh, PatchSe
   std::filesystem::path path = e["mesh"].get<std::string>();
   if (path.is_relative()) path = std::filesystem::path(place.file).parent_path() / path;
   TriangleMesh file = ReadMeshFile(path.string());
-  mesh->vertices = std::move(file.vertices);
-  mesh->normals = std::move(file.normals);
-  mesh->triangles = std::move(file.triangles);
   for (std::string& note : file.notes) set->notes.push_back(std::move(note));
+  // The mesh file's own defaults (its normals rarely fit the seed's
+  // conditions as they are); the tolerance, mu and free are the JSON's.
+  double file_tolerance = 0;
+  *mesh = MeshFileConstruction(std::move(file), &file_tolerance);
+  mesh->mu_from_normals = !e.contains("mu") && !e.contains("free");
 }
 
 void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
@@ -470,10 +472,6 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
   QuadricMesh mesh;
   if (e.contains("mesh")) {
     ReadMeshField(e, place, &mesh, set);
-    // A mesh file's normals rarely fit the seed's conditions as they are:
-    // the same defaults as the file given to the tool directly.
-    mesh.mu_from_normals = !e.contains("mu") && !e.contains("free");
-    mesh.adjust_normals = true;
   } else {
     ParseInlineMesh(e, place, &mesh);
   }
@@ -505,19 +503,13 @@ void AddQuadricHermite(const json& e, const Place& place, PatchSet* set) {
 
 }  // namespace
 
-PatchSet MeshFileAsPatchSet(const std::string& path) {
-  TriangleMesh file = ReadMeshFile(path);
-  PatchSet set;
-  set.notes = std::move(file.notes);
+QuadricMesh MeshFileConstruction(TriangleMesh file, double* tolerance) {
   QuadricMesh mesh;
   mesh.vertices = std::move(file.vertices);
   mesh.normals = std::move(file.normals);
   mesh.triangles = std::move(file.triangles);
   mesh.mu_from_normals = true;
   mesh.adjust_normals = true;
-  // The default tolerance follows the mesh's size, as files come in metres,
-  // millimetres or inches: 1e-4 of the largest extent (0.01 mm on a 100 mm
-  // drawing, below a plotter's step).
   Point3 lo = mesh.vertices.front();
   Point3 hi = lo;
   for (const Point3& v : mesh.vertices) {
@@ -526,9 +518,18 @@ PatchSet MeshFileAsPatchSet(const std::string& path) {
       hi[c] = std::max(hi[c], v[c]);
     }
   }
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  *tolerance = 1e-4 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  return mesh;
+}
+
+PatchSet MeshFileAsPatchSet(const std::string& path) {
+  TriangleMesh file = ReadMeshFile(path);
+  PatchSet set;
+  set.notes = std::move(file.notes);
+  double tolerance = 0;
+  const QuadricMesh mesh = MeshFileConstruction(std::move(file), &tolerance);
   try {
-    QuadricResult result = BuildQuadricMesh(mesh, 1e-4 * extent, path + ": quadric-hermite");
+    QuadricResult result = BuildQuadricMesh(mesh, tolerance, path + ": quadric-hermite");
     set.curves = std::move(result.curves);
     for (std::string& note : result.notes) set.notes.push_back(std::move(note));
   } catch (const ConstructionError& error) {

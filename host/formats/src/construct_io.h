@@ -37,9 +37,8 @@ Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place);
 void AddConstructions(const nlohmann::json& construct, const std::string& file, PatchSet* set);
 
 /// Reads an OBJ or PLY mesh and draws it as quadric Hermite pieces (row 12
-/// of docs/constructions.md) with μ from its normals, the normals turned
-/// where the triangles' conditions need it, 8 sections per piece and a
-/// tolerance of 1e-4 of the mesh's extent. Throws InputError naming the file.
+/// of docs/constructions.md) by MeshFileConstruction (patch_io.h). Throws
+/// InputError naming the file.
 PatchSet MeshFileAsPatchSet(const std::string& path);
 
 /// Appends the curves of every entry in `curves` (a JSON array) to `set`.

@@ -5,7 +5,9 @@
 #include <string>
 
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/mesh_io.h"
 #include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/quadric_hermite.h"
 
 namespace fdsurf::host {
 
@@ -15,6 +17,12 @@ namespace fdsurf::host {
 /// the first non-blank character. Throws InputError on anything malformed or
 /// a mesh the construction refuses.
 PatchSet ReadPatchFile(const std::string& path);
+
+/// The construction a mesh file is drawn by (docs/formats.md): μ from its
+/// normals, the normals turned where the triangles' conditions need it,
+/// 8 sections per piece; *tolerance gets 1e-4 of the mesh's largest extent
+/// (files come in metres, millimetres or inches: 0.01 mm on a 100 mm mesh).
+QuadricMesh MeshFileConstruction(TriangleMesh file, double* tolerance);
 
 /// The same from text already in memory; `name` is used in messages.
 PatchSet ParseBpt(const std::string& text, const std::string& name);
