@@ -84,22 +84,26 @@ CubicArc ApproximateArc(const RationalQuadratic& arc) {
   return cubic;
 }
 
-std::vector<CubicArc> ArcToCubics(const RationalQuadratic& arc, double tolerance) {
-  constexpr int kMaxDepth = 20;
+std::vector<CubicArc> ArcToCubics(const RationalQuadratic& arc, double tolerance,
+                                  const std::function<double(const RationalQuadratic&)>& extra) {
+  constexpr int kMaxDepth = 24;
   std::vector<CubicArc> out;
   // Depth-first, first half first, so that the cubics come out in order.
   std::vector<std::pair<RationalQuadratic, int>> stack = {{arc, 0}};
   while (!stack.empty()) {
     const auto [piece, depth] = stack.back();
     stack.pop_back();
-    const CubicArc cubic = ApproximateArc(piece);
+    CubicArc cubic = ApproximateArc(piece);
+    if (extra) cubic.bound += extra(piece);
     if (cubic.bound <= tolerance) {
       out.push_back(cubic);
       continue;
     }
     if (depth >= kMaxDepth) {
-      throw ConstructionError("a conic arc needs more than 2^20 cubic pieces for tolerance " +
-                              FormatNumber(tolerance) + " (below the arithmetic's rounding)");
+      throw ConstructionError("a conic arc cannot be bounded within tolerance " +
+                              FormatNumber(tolerance) +
+                              " by 2^24 cubic pieces (below the arithmetic's rounding, or the "
+                              "surface is nearly singular there)");
     }
     RationalQuadratic first;
     RationalQuadratic second;

@@ -9,7 +9,6 @@
 #include <string>
 
 #include "fdsurf/host/errors.h"
-#include "fdsurf/host/text.h"
 #include "fdsurf/host/vec3.h"
 
 namespace fdsurf::host::internal {
@@ -366,35 +365,12 @@ void PieceDrawer::Emit(const BranchArc& a, QuadricArc::Role role, int index,
     arc.role = role;
     arc.index = index;
     arc.arc = rq;
-    // Halved until each cubic's bound plus its sub-arc's own distance from
-    // the quadric (rounding, and a Lipschitz bound that needs a short arc)
-    // is within the tolerance; in order, first half first.
-    std::vector<std::pair<RationalQuadratic, int>> stack = {{rq, 0}};
-    while (!stack.empty()) {
-      const auto [piece, depth] = stack.back();
-      stack.pop_back();
-      CubicArc cubic = ApproximateArc(piece);
-      const double total = cubic.bound + ArcDistanceBound(piece, *in_.f);
-      if (total <= in_.tolerance) {
-        cubic.bound = total;
-        arc.bound = std::max(arc.bound, total);
-        arc.cubics.push_back(cubic);
-        continue;
-      }
-      if (depth >= 24) {
-        throw ConstructionError(
-            "an arc's distance from the quadric cannot be bounded "
-            "within tolerance " +
-            FormatNumber(in_.tolerance) +
-            " (the quadric is nearly singular "
-            "there)");
-      }
-      RationalQuadratic first;
-      RationalQuadratic second;
-      SplitArc(piece, &first, &second);
-      stack.emplace_back(second, depth + 1);
-      stack.emplace_back(first, depth + 1);
-    }
+    // Each cubic's bound includes its sub-arc's own distance from the
+    // quadric (rounding, and a Lipschitz bound that needs a short arc).
+    arc.cubics = ArcToCubics(rq, in_.tolerance, [&](const RationalQuadratic& piece) {
+      return ArcDistanceBound(piece, *in_.f);
+    });
+    for (const CubicArc& cubic : arc.cubics) arc.bound = std::max(arc.bound, cubic.bound);
     out->push_back(std::move(arc));
   }
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "fdsurf/config/nodiscard.h"
@@ -47,8 +48,13 @@ void SplitArc(const RationalQuadratic& arc, RationalQuadratic* first, RationalQu
 FDSURF_NODISCARD CubicArc ApproximateArc(const RationalQuadratic& arc);
 
 /// Cubics covering the arc in order, each with bound ≤ tolerance: the arc is
-/// halved until each piece's bound is met. Throws ConstructionError when that
-/// takes more than 2^20 pieces (a tolerance below the arithmetic's rounding).
-std::vector<CubicArc> ArcToCubics(const RationalQuadratic& arc, double tolerance);
+/// halved until each piece's bound is met. `extra`, when given, is a further
+/// bound for a piece (e.g. the piece's own distance from a surface) that is
+/// added to its cubic's bound, which then includes it. Throws
+/// ConstructionError when that takes more than 2^24 pieces (a tolerance below
+/// the arithmetic's rounding, or an extra bound that does not shrink).
+std::vector<CubicArc> ArcToCubics(
+    const RationalQuadratic& arc, double tolerance,
+    const std::function<double(const RationalQuadratic&)>& extra = nullptr);
 
 }  // namespace fdsurf::host
