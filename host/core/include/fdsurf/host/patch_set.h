@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,11 @@ struct Curve {
   Basis basis = Basis::kHermite;
   std::array<Point3, 4> g{};
   std::string origin;
+  /// Index into PatchSet::layers (0 when the file has no layers).
+  int layer = 0;
+  /// A straight segment from its first to its last point (an SVG `L`, a
+  /// G-code `G1`): `stream` may send it as a MOVE instead of a CURVE.
+  bool straight = false;
 };
 
 struct PatchSet {
@@ -40,6 +46,16 @@ struct PatchSet {
   /// What the constructions found, one line each (join classes, scale
   /// factors, approximation bounds); `fdsurf check` prints them.
   std::vector<std::string> notes;
+  /// Names of the drawing's layers (Inkscape layers, stroke colours, G-code
+  /// tool changes), in drawing order; Curve::layer indexes it. Empty: one
+  /// unnamed layer. Between layers the pen is changed (a pause).
+  std::vector<std::string> layers;
+  /// The file's own page, width × height in its units, with the origin at
+  /// its lower left (an SVG's width and height); nullopt when it has none.
+  std::optional<std::array<double, 2>> page;
+  /// The curves are a program whose order is the user's (G-code): planners
+  /// keep it instead of reordering.
+  bool keep_order = false;
 };
 
 }  // namespace fdsurf::host
