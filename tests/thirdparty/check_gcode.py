@@ -31,7 +31,7 @@ def main():
     with open(strokes_file, encoding="utf-8") as f:
         expected = json.load(f)
     result = subprocess.run(["node", os.path.join(HERE, "gcode_segments.js"), gcode_file],
-                            capture_output=True, text=True, check=False)
+                            capture_output=True, text=True, check=False, timeout=300)
     if result.returncode != 0:
         fail(f"gcode-toolpath could not read {gcode_file}: {result.stderr.strip()}")
     segments = json.loads(result.stdout)

@@ -125,6 +125,30 @@ void PrintSummary(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
   if (!png.empty()) std::fprintf(stderr, "wrote %s (png, %d px wide)\n", png.c_str(), o.png_width);
 }
 
+// --flavor and the options that only some flavours use (docs/toolpaths.md).
+void AddGcodeFlavorOptions(CLI::App* command, GcodeOptions* g) {
+  command
+      ->add_option("--flavor", g->flavor,
+                   "G-code dialect: generic, grbl, marlin (G5, G4 P in ms, M280) or linuxcnc (G5)")
+      ->check(CLI::IsMember({"generic", "grbl", "marlin", "linuxcnc"}))
+      ->capture_default_str();
+  command->add_flag("!--no-g5", g->g5, "G1 segments even where the flavour has G5 cubics");
+  command->add_option("--servo-up", g->servo_up, "--pen servo: the angle with the pen up")
+      ->check(CLI::Range(0.0, 360.0))
+      ->capture_default_str();
+  command->add_option("--servo-down", g->servo_down, "--pen servo: the angle with the pen down")
+      ->check(CLI::Range(0.0, 360.0))
+      ->capture_default_str();
+  command->add_option("--servo-index", g->servo_index, "--pen servo: M280's servo index P")
+      ->check(CLI::Range(0, 15))
+      ->capture_default_str();
+  command
+      ->add_option("--travel-rate", g->travel_rate,
+                   "G0 rate assumed by the time estimate, units per minute")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 }  // namespace
 
 int RunPlot(const PlotOptions& o, bool render_only) {
@@ -218,9 +242,11 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
         ->capture_default_str();
     command
         ->add_option("--pen", o->gcode.pen,
-                     "G-code pen control: z (Z moves) or m3 (M3/M5 and a dwell)")
-        ->check(CLI::IsMember({"z", "m3"}))
+                     "G-code pen control: z (Z moves), m3 (M3/M5 and a dwell) or servo (Marlin "
+                     "M280 and a dwell)")
+        ->check(CLI::IsMember({"z", "m3", "servo"}))
         ->capture_default_str();
+    AddGcodeFlavorOptions(command, &o->gcode);
     command
         ->add_option("--pen-up", o->gcode.pen_up_z,
                      "G-code Z with the pen up (also 3-D travel height)")

@@ -85,6 +85,19 @@ std::pair<double, double> PenLengths(const std::vector<Stroke>& strokes) {
 void Reverse(Stroke* s) {
   std::reverse(s->points.begin(), s->points.end());
   std::reverse(s->params.begin(), s->params.end());
+  std::reverse(s->cubics.begin(), s->cubics.end());
+  for (auto& cubic : s->cubics) std::reverse(cubic.begin(), cubic.end());
+}
+
+// Appends `other` (which starts where `chain` ends) to `chain`; the cubics
+// stay a complete description only when both have them.
+void Append(Stroke* chain, const Stroke& other) {
+  chain->points.insert(chain->points.end(), other.points.begin() + 1, other.points.end());
+  if (chain->cubics.empty() || other.cubics.empty()) {
+    chain->cubics.clear();
+  } else {
+    chain->cubics.insert(chain->cubics.end(), other.cubics.begin(), other.cubics.end());
+  }
 }
 
 // The exact curve a stroke of BuildToolpath draws.
@@ -142,7 +155,7 @@ std::vector<Stroke> JoinTouching(std::vector<Stroke> strokes) {
         used[static_cast<std::size_t>(next)] = true;
         Stroke& other = strokes[static_cast<std::size_t>(next)];
         if (other.points.front() != chain.points.back()) Reverse(&other);
-        chain.points.insert(chain.points.end(), other.points.begin() + 1, other.points.end());
+        Append(&chain, other);
       }
       Reverse(&chain);  // then extend the other end
     }
@@ -152,15 +165,15 @@ std::vector<Stroke> JoinTouching(std::vector<Stroke> strokes) {
   return joined;
 }
 
-// 3. Nearest neighbour from the origin, reversing where it helps.
-std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes) {
+// 3. Nearest neighbour from `start`, reversing where it helps.
+std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes, const PlanPoint& start) {
   std::vector<std::array<PlanPoint, 2>> ends;
   ends.reserve(strokes.size());
   for (const Stroke& s : strokes)
     ends.push_back({ToPlan(s.points.front()), ToPlan(s.points.back())});
   std::vector<Stroke> ordered;
   ordered.reserve(strokes.size());
-  for (const Visit& visit : OrderNearestNeighbour(ends, true, PlanMetric::kPlane)) {
+  for (const Visit& visit : OrderNearestNeighbour(ends, true, PlanMetric::kPlane, start)) {
     if (visit.reversed) Reverse(&strokes[visit.index]);
     ordered.push_back(std::move(strokes[visit.index]));
   }
@@ -170,14 +183,12 @@ std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes) {
 // 4. 2-opt: reversing the run i..j (and each stroke in it) replaces the
 // links exit(i-1)→entry_of(i) and exit_of(j)→entry(j+1) by exit(i-1)→exit_of(j) and
 // entry_of(i)→entry(j+1). A window keeps large drawings fast.
-void ImproveByTwoOpt(std::vector<Stroke>* strokes) {
+void ImproveByTwoOpt(std::vector<Stroke>* strokes, const PlanPoint& start) {
   std::vector<Stroke>& ordered = *strokes;
   const std::size_t n = ordered.size();
   const auto entry_of = [&](std::size_t k) { return ToPlan(ordered[k].points.front()); };
   const auto exit_of = [&](std::size_t k) { return ToPlan(ordered[k].points.back()); };
-  const auto exit_before = [&](std::size_t k) {
-    return k == 0 ? PlanPoint{0, 0, 0} : exit_of(k - 1);
-  };
+  const auto exit_before = [&](std::size_t k) { return k == 0 ? start : exit_of(k - 1); };
   constexpr std::size_t kWindow = 300;
   constexpr int kPasses = 30;
   for (int pass = 0; pass < kPasses; ++pass) {
@@ -200,6 +211,17 @@ void ImproveByTwoOpt(std::vector<Stroke>* strokes) {
     }
     if (!improved) break;
   }
+}
+
+// The strokes of each layer, layers in order (a stroke's layer below 0 counts as 0).
+std::vector<std::vector<Stroke>> SplitByLayer(std::vector<Stroke> strokes) {
+  std::vector<std::vector<Stroke>> layers;
+  for (Stroke& s : strokes) {
+    const auto layer = static_cast<std::size_t>(std::max(0, s.layer));
+    if (layer >= layers.size()) layers.resize(layer + 1);
+    layers[layer].push_back(std::move(s));
+  }
+  return layers;
 }
 
 }  // namespace
@@ -274,11 +296,20 @@ PlanReport PlanStrokes(const PatchSet& set, Toolpath* path) {
   report.pen_down_before = down_before * q;
   report.pen_up_before = up_before * q;
 
-  std::vector<Stroke> strokes =
-      RemoveDrawnTwice(set, *path, std::move(path->strokes), &report.duplicates_removed);
-  strokes = OrderStrokes(JoinTouching(std::move(strokes)));
-  ImproveByTwoOpt(&strokes);
-  path->strokes = std::move(strokes);
+  // Each layer is planned on its own (a pen change lies between layers), in
+  // layer order, starting where the layer before it left the pen; nothing is
+  // joined, removed as a duplicate or reordered across layers.
+  std::vector<Stroke> planned;
+  PlanPoint pen{0, 0, 0};
+  for (std::vector<Stroke>& layer : SplitByLayer(std::move(path->strokes))) {
+    std::vector<Stroke> strokes =
+        RemoveDrawnTwice(set, *path, std::move(layer), &report.duplicates_removed);
+    strokes = OrderStrokes(JoinTouching(std::move(strokes)), pen);
+    ImproveByTwoOpt(&strokes, pen);
+    if (!strokes.empty()) pen = ToPlan(strokes.back().points.back());
+    for (Stroke& s : strokes) planned.push_back(std::move(s));
+  }
+  path->strokes = std::move(planned);
 
   report.strokes_after = path->strokes.size();
   const auto [down_after, up_after] = PenLengths(path->strokes);

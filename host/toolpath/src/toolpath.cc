@@ -221,11 +221,27 @@ void StepLine(const PowerCurve1 (&curve)[kDims], const ToolpathOptions& options,
   }
 }
 
+using StrokeCubic = std::array<std::array<double, 3>, 4>;
+
+// A cubic's Bézier control points through the output map (they are points,
+// so the whole affine map), z = 0 in 2-D.
+StrokeCubic MappedBezier(const std::array<Point3, 4>& power_ascending, const OutputMap& map,
+                         int dims) {
+  StrokeCubic out{};
+  const std::array<Point3, 4> bezier = BezierFromPower(power_ascending);
+  for (int k = 0; k < 4; ++k) {
+    out[k] = map.Apply(bezier[k]);
+    if (dims == 2) out[k][2] = 0;
+  }
+  return out;
+}
+
 template <int kDims>
 void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
                const ToolpathOptions& options, std::vector<Stroke>* strokes) {
   PatchGeometry1 geometry[kDims];
   PatchToQuanta(patch, map, options.quantum, kDims, geometry);
+  const PowerCoefficients exact = CoefficientsOf(patch);
   const auto draw_family = [&](IsolineFamily family, int lines) {
     if (lines == 0) return;
     IsolineWalker<kDims> walker;
@@ -242,6 +258,9 @@ void DrawPatch(const Patch& patch, std::size_t index, const OutputMap& map,
                patch.origin + ": " + (family == IsolineFamily::kSLines ? "s" : "t") + "-line " +
                    std::to_string(i),
                &stroke);
+      // An isoline of a bicubic patch is a cubic: its exact power form, ascending.
+      const auto line = LineCoefficients(exact, family, stroke.line_param);
+      stroke.cubics.push_back(MappedBezier({line[3], line[2], line[1], line[0]}, map, kDims));
       // A line that collapses to a point (a pole, like the teapot lid's top) draws nothing.
       if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
     }
@@ -260,6 +279,11 @@ void DrawCurve(const Curve& curve, std::size_t index, const OutputMap& map,
   if (status != Status::kOk) Refuse(options, status, curve.origin);
   Stroke stroke;
   stroke.curve = static_cast<std::ptrdiff_t>(index);
+  stroke.layer = curve.layer;
+  const VecPoly exact = CurvePolynomial(curve);  // ascending, degree ≤ 3
+  std::array<Point3, 4> ascending{};
+  for (std::size_t k = 0; k < exact.size() && k < 4; ++k) ascending[k] = exact[k];
+  stroke.cubics.push_back(MappedBezier(ascending, map, kDims));
   StepLine(power, options, curve.origin, &stroke);
   if (stroke.points.size() >= 2) strokes->push_back(std::move(stroke));
 }
@@ -408,6 +432,8 @@ Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std
 Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
                        const std::string& units, const Progress& progress) {
   Toolpath path = PlanPage(set, options, units);
+  path.tolerance = options.tolerance;
+  path.layers = set.layers;
   for (std::size_t p = 0; p < set.patches.size(); ++p) {
     if (options.dims == 3) {
       DrawPatch<3>(set.patches[p], p, path.map, options, &path.strokes);
@@ -428,6 +454,20 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
     }
   }
   return path;
+}
+
+std::array<Point3, 4> BezierFromPower(const std::array<Point3, 4>& power) {
+  // p(u) = Σ a_k u^k in the Bernstein basis: b0 = a0, b1 = a0 + a1/3,
+  // b2 = a0 + 2a1/3 + a2/3, b3 = a0 + a1 + a2 + a3.
+  std::array<Point3, 4> bezier{};
+  for (int c = 0; c < 3; ++c) {
+    const double a0 = power[0][c], a1 = power[1][c], a2 = power[2][c], a3 = power[3][c];
+    bezier[0][c] = a0;
+    bezier[1][c] = a0 + a1 / 3;
+    bezier[2][c] = a0 + (2 * a1 + a2) / 3;
+    bezier[3][c] = a0 + a1 + a2 + a3;
+  }
+  return bezier;
 }
 
 std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,

@@ -4,6 +4,7 @@
 
 #include <cairo.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -41,6 +42,254 @@ std::string XmlEscaped(const std::string& text) {
   return out;
 }
 
+std::string LayerName(const Toolpath& path, const Stroke& s) {
+  const auto index = static_cast<std::size_t>(std::max(0, s.layer));
+  return index < path.layers.size() ? path.layers[index] : "layer " + std::to_string(s.layer);
+}
+
+// What a G-code dialect has (docs/toolpaths.md, "G-code flavours").
+struct Flavor {
+  std::string name;
+  bool has_g5 = false;          // G5 I J P Q X Y cubics
+  bool has_m280 = false;        // servo pen
+  bool dwell_ms = false;        // G4 P is milliseconds (Marlin), else seconds
+  bool paren_comments = false;  // (comment) rather than ; comment
+  bool needs_g17 = false;       // G5 only in the XY plane, selected by G17
+};
+
+Flavor FlavorNamed(const std::string& name) {
+  if (name == "generic") return Flavor{name};
+  if (name == "grbl") return Flavor{name, false, false, false, true, false};
+  if (name == "marlin") return Flavor{name, true, true, true, false, false};
+  if (name == "linuxcnc") return Flavor{name, true, false, false, true, true};
+  throw OptionError("flavor", name, "is not one of generic, grbl, marlin, linuxcnc");
+}
+
+using QuantaPoint = std::array<std::int64_t, 2>;
+
+double PlaneLength(const QuantaPoint& a, const QuantaPoint& b) {
+  return std::hypot(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]));
+}
+
+// Writes one program; every choice a flavour makes is in Flavor.
+class GcodeWriter {
+ public:
+  GcodeWriter(const Toolpath& path, const GcodeOptions& options)
+      : path_(path),
+        options_(options),
+        flavor_(FlavorNamed(options.flavor)),
+        q_(path.quantum),
+        three_d_(path.dims == 3),
+        pen_(three_d_ ? "z" : options.pen) {
+    if (pen_ != "z" && pen_ != "m3" && pen_ != "servo") {
+      throw OptionError("pen", options.pen, "is not one of z, m3, servo");
+    }
+    if (pen_ == "servo" && !flavor_.has_m280) {
+      throw OptionError(
+          "pen", "servo",
+          "needs M280 (Marlin); the flavour " + flavor_.name + " has no servo command");
+    }
+    use_g5_ = flavor_.has_g5 && options.g5 && !three_d_;
+  }
+
+  std::string Write(const std::vector<std::string>& header) {
+    for (const std::string& line : header) Comment(line);
+    if (flavor_.name != "generic") {
+      Comment("flavor " + flavor_.name + (use_g5_ ? ", cubics as G5" : ", cubics as G1 segments") +
+              ", dwell G4 P in " + (flavor_.dwell_ms ? "milliseconds" : "seconds"));
+      Comment("estimated time " + FormatDuration(EstimateSeconds()) +
+              " (pen-down length / feed + travel / " + FormatNumber(options_.travel_rate) + " " +
+              path_.units + "/min + plunges + dwells)");
+    }
+    out_ << (path_.units == "in" ? "G20" : "G21") << Trailing("units: " + path_.units) << "\n"
+         << "G90" << Trailing("absolute positions") << "\n";
+    if (flavor_.needs_g17 && use_g5_) out_ << "G17" << Trailing("XY plane, for G5") << "\n";
+    PenUp();
+    int layer = -1;
+    for (const Stroke& s : path_.strokes) {
+      if (!path_.layers.empty() && s.layer != layer) {
+        if (layer >= 0) {
+          Comment("pen change: layer '" + LayerName(path_, s) + "'");
+          out_ << "M0\n";
+        } else {
+          Comment("layer '" + LayerName(path_, s) + "'");
+        }
+        layer = s.layer;
+      }
+      if (use_g5_ && !s.cubics.empty()) {
+        WriteCubics(s);
+      } else {
+        WriteSegments(s);
+      }
+      PenUp();
+    }
+    out_ << "G0 X0 Y0\nM2\n";
+    return out_.str();
+  }
+
+  // The model of docs/toolpaths.md, "Time estimate".
+  double EstimateSeconds() const {
+    const double unit = q_.value();
+    double down = 0;    // quanta, at feed
+    double travel = 0;  // quanta in the plane, at travel_rate
+    QuantaPoint pen{0, 0};
+    double plunge = 0;  // units, at plunge_feed
+    double lift = 0;    // units, at travel_rate
+    for (const Stroke& s : path_.strokes) {
+      travel += PlaneLength(pen, {s.points.front()[0], s.points.front()[1]});
+      for (std::size_t k = 1; k < s.points.size(); ++k) {
+        const auto& a = s.points[k - 1];
+        const auto& b = s.points[k];
+        const double dz = three_d_ ? static_cast<double>(b[2] - a[2]) : 0.0;
+        down += std::hypot(PlaneLength({a[0], a[1]}, {b[0], b[1]}), dz);
+      }
+      pen = {s.points.back()[0], s.points.back()[1]};
+      if (three_d_) {
+        plunge += std::fabs(options_.pen_up_z - s.points.front()[2] * unit);
+        lift += std::fabs(options_.pen_up_z - s.points.back()[2] * unit);
+      } else if (pen_ == "z") {
+        plunge += std::fabs(options_.pen_up_z - options_.pen_down_z);
+        lift += std::fabs(options_.pen_up_z - options_.pen_down_z);
+      }
+    }
+    travel += PlaneLength(pen, {0, 0});
+    const bool dwells = pen_ != "z";
+    const double dwell_count = dwells ? 1.0 + 2.0 * path_.strokes.size() : 0.0;
+    return 60 * (down * unit / options_.feed + (travel * unit + lift) / options_.travel_rate +
+                 plunge / options_.plunge_feed) +
+           dwell_count * options_.dwell;
+  }
+
+ private:
+  static std::string FormatDuration(double seconds) {
+    const auto whole = static_cast<long long>(std::llround(seconds));
+    char text[48];
+    std::snprintf(text, sizeof text, "%lld:%02lld:%02lld", whole / 3600, whole / 60 % 60,
+                  whole % 60);
+    return text;
+  }
+
+  // A comment line in the flavour's syntax.
+  void Comment(const std::string& text) {
+    if (flavor_.paren_comments) {
+      out_ << "(" << Parenless(text) << ")\n";
+    } else {
+      out_ << "; " << text << "\n";
+    }
+  }
+
+  // A comment after a command on the same line.
+  std::string Trailing(const std::string& text) const {
+    return flavor_.paren_comments ? " (" + Parenless(text) + ")" : " ; " + text;
+  }
+
+  // Parenthesised comments cannot nest: inner parentheses become brackets.
+  static std::string Parenless(std::string text) {
+    for (char& c : text) {
+      if (c == '(') c = '[';
+      if (c == ')') c = ']';
+    }
+    return text;
+  }
+
+  void Dwell() {
+    if (flavor_.dwell_ms) {
+      out_ << "G4 P" << std::llround(options_.dwell * 1000) << "\n";
+    } else {
+      out_ << "G4 P" << FormatNumber(options_.dwell) << "\n";
+    }
+  }
+
+  void PenUp() {
+    if (pen_ == "z") {
+      out_ << "G0 Z" << FormatNumber(options_.pen_up_z) << "\n";
+    } else if (pen_ == "m3") {
+      out_ << "M5\n";
+      Dwell();
+    } else {
+      out_ << "M280 P" << options_.servo_index << " S" << FormatNumber(options_.servo_up) << "\n";
+      Dwell();
+    }
+  }
+
+  void PenDown(const std::array<std::int64_t, 3>& first) {
+    if (three_d_) {
+      out_ << "G1 Z" << q_.Format(first[2]) << " F" << FormatNumber(options_.plunge_feed) << "\n";
+    } else if (pen_ == "z") {
+      out_ << "G1 Z" << FormatNumber(options_.pen_down_z) << " F"
+           << FormatNumber(options_.plunge_feed) << "\n";
+    } else if (pen_ == "m3") {
+      out_ << "M3 S" << options_.power << "\n";
+      Dwell();
+    } else {
+      out_ << "M280 P" << options_.servo_index << " S" << FormatNumber(options_.servo_down) << "\n";
+      Dwell();
+    }
+  }
+
+  void WriteSegments(const Stroke& s) {
+    const auto& first = s.points.front();
+    out_ << "G0 X" << q_.Format(first[0]) << " Y" << q_.Format(first[1]) << "\n";
+    PenDown(first);
+    for (std::size_t k = 1; k < s.points.size(); ++k) {
+      out_ << "G1 X" << q_.Format(s.points[k][0]) << " Y" << q_.Format(s.points[k][1]);
+      if (three_d_) out_ << " Z" << q_.Format(s.points[k][2]);
+      if (k == 1) out_ << " F" << FormatNumber(options_.feed);
+      out_ << "\n";
+    }
+  }
+
+  QuantaPoint Rounded(const std::array<double, 3>& p) const {
+    return {std::llround(q_.ToQuanta(p[0])), std::llround(q_.ToQuanta(p[1]))};
+  }
+
+  // Distance in output units between a printed point and the exact one.
+  double Error(const QuantaPoint& printed, const std::array<double, 3>& exact) const {
+    return std::hypot(printed[0] * q_.value() - exact[0], printed[1] * q_.value() - exact[1]);
+  }
+
+  // Each piece as G5 from the current position: I J = first control point −
+  // start, P Q = second control point − end (Marlin's and LinuxCNC's words).
+  void WriteCubics(const Stroke& s) {
+    QuantaPoint at = Rounded(s.cubics.front()[0]);
+    out_ << "G0 X" << q_.Format(at[0]) << " Y" << q_.Format(at[1]) << "\n";
+    PenDown(s.points.front());
+    bool first = true;
+    for (const auto& cubic : s.cubics) {
+      const QuantaPoint c1 = Rounded(cubic[1]);
+      const QuantaPoint c2 = Rounded(cubic[2]);
+      const QuantaPoint end = Rounded(cubic[3]);
+      // Convex hull: the printed curve is within the largest control-point
+      // error of the exact one (docs/toolpaths.md, "G5 and the quantum").
+      const double error = std::max(
+          {Error(at, cubic[0]), Error(c1, cubic[1]), Error(c2, cubic[2]), Error(end, cubic[3])});
+      if (path_.tolerance > 0 && error > path_.tolerance) {
+        throw OptionError("tolerance", FormatNumber(path_.tolerance) + " " + path_.units,
+                          "is smaller than the " + FormatNumber(error) + " " + path_.units +
+                              " that G5 control points printed at the quantum " + q_.Format(1) +
+                              " move a curve; use a larger tolerance or G1 segments (--no-g5)");
+      }
+      if (c1 == at && c2 == at && end == at) continue;  // draws nothing
+      out_ << "G5 I" << q_.Format(c1[0] - at[0]) << " J" << q_.Format(c1[1] - at[1]) << " P"
+           << q_.Format(c2[0] - end[0]) << " Q" << q_.Format(c2[1] - end[1]) << " X"
+           << q_.Format(end[0]) << " Y" << q_.Format(end[1]);
+      if (first) out_ << " F" << FormatNumber(options_.feed);
+      out_ << "\n";
+      first = false;
+      at = end;
+    }
+  }
+
+  const Toolpath& path_;
+  const GcodeOptions& options_;
+  Flavor flavor_;
+  const Quantum& q_;
+  bool three_d_;
+  std::string pen_;
+  bool use_g5_ = false;
+  std::ostringstream out_;
+};
+
 }  // namespace
 
 std::string WriteSvg(const Toolpath& path, const std::string& title) {
@@ -50,17 +299,26 @@ std::string WriteSvg(const Toolpath& path, const std::string& title) {
   const std::string width = q.Format(w);
   const std::string height = q.Format(h);
   const double pen = path.units == "in" ? 0.01 : 0.25;
+  const bool layered = !path.layers.empty();
   std::ostringstream out;
   out << R"(<?xml version="1.0" encoding="UTF-8"?>)"
       << "\n"
-      << R"(<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width=")" << width << path.units
-      << R"(" height=")" << height << path.units << R"(" viewBox="0 0 )" << width << " " << height
-      << "\">\n"
+      << R"(<svg xmlns="http://www.w3.org/2000/svg" )"
+      << (layered ? R"(xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" )" : "")
+      << R"(version="1.1" width=")" << width << path.units << R"(" height=")" << height
+      << path.units << R"(" viewBox="0 0 )" << width << " " << height << "\">\n"
       << "<title>" << XmlEscaped(title) << "</title>\n"
       << R"(<g fill="none" stroke="black" stroke-width=")" << FormatNumber(pen)
       << R"(" stroke-linecap="round" stroke-linejoin="round">)"
       << "\n";
+  int open_layer = -1;  // the layer group being written, -1 for none
   for (const Stroke& s : path.strokes) {
+    if (layered && s.layer != open_layer) {
+      if (open_layer >= 0) out << "</g>\n";
+      open_layer = s.layer;
+      out << R"(<g inkscape:groupmode="layer" inkscape:label=")" << XmlEscaped(LayerName(path, s))
+          << "\">\n";
+    }
     out << "<path d=\"";
     for (std::size_t k = 0; k < s.points.size(); ++k) {
       out << (k == 0 ? "M" : " L") << q.Format(s.points[k][0]) << " "
@@ -68,48 +326,18 @@ std::string WriteSvg(const Toolpath& path, const std::string& title) {
     }
     out << "\"/>\n";
   }
+  if (open_layer >= 0) out << "</g>\n";
   out << "</g>\n</svg>\n";
   return out.str();
 }
 
 std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
                        const std::vector<std::string>& header) {
-  const Quantum& q = path.quantum;
-  const bool three_d = path.dims == 3;
-  const bool z_pen = options.pen == "z";
-  std::ostringstream out;
-  for (const std::string& line : header) out << "; " << line << "\n";
-  out << (path.units == "in" ? "G20" : "G21") << " ; units: " << path.units << "\n"
-      << "G90 ; absolute positions\n";
-  const auto pen_up = [&] {
-    if (z_pen || three_d) {
-      out << "G0 Z" << FormatNumber(options.pen_up_z) << "\n";
-    } else {
-      out << "M5\nG4 P" << FormatNumber(options.dwell) << "\n";
-    }
-  };
-  pen_up();
-  for (const Stroke& s : path.strokes) {
-    const auto& first = s.points.front();
-    out << "G0 X" << q.Format(first[0]) << " Y" << q.Format(first[1]) << "\n";
-    if (three_d) {
-      out << "G1 Z" << q.Format(first[2]) << " F" << FormatNumber(options.plunge_feed) << "\n";
-    } else if (z_pen) {
-      out << "G1 Z" << FormatNumber(options.pen_down_z) << " F" << FormatNumber(options.plunge_feed)
-          << "\n";
-    } else {
-      out << "M3 S" << options.power << "\nG4 P" << FormatNumber(options.dwell) << "\n";
-    }
-    for (std::size_t k = 1; k < s.points.size(); ++k) {
-      out << "G1 X" << q.Format(s.points[k][0]) << " Y" << q.Format(s.points[k][1]);
-      if (three_d) out << " Z" << q.Format(s.points[k][2]);
-      if (k == 1) out << " F" << FormatNumber(options.feed);
-      out << "\n";
-    }
-    pen_up();
-  }
-  out << "G0 X0 Y0\nM2\n";
-  return out.str();
+  return GcodeWriter(path, options).Write(header);
+}
+
+double EstimateGcodeSeconds(const Toolpath& path, const GcodeOptions& options) {
+  return GcodeWriter(path, options).EstimateSeconds();
 }
 
 std::string WriteHpgl(const Toolpath& path) {

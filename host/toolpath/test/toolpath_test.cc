@@ -261,6 +261,82 @@ TEST(Toolpath, PlanningKeepsEverySegmentAndCutsTravel) {
   EXPECT_LT(report.pen_down_after, report.pen_down_before);
 }
 
+// De Casteljau on a stroke's cubic: written here again, not the writer's code.
+std::array<double, 3> BezierAt(const std::array<std::array<double, 3>, 4>& b, double u) {
+  auto p = b;
+  for (int level = 3; level > 0; --level) {
+    for (int k = 0; k < level; ++k) {
+      for (int c = 0; c < 3; ++c) p[k][c] = (1 - u) * p[k][c] + u * p[k + 1][c];
+    }
+  }
+  return p[0];
+}
+
+// Every stroke's cubic is its exact curve: isolines of random patches of every
+// basis (2-D and 3-D, a rotated view) and the file's curves, against the
+// reference evaluation through the same map at 33 parameters.
+TEST(Toolpath, StrokeCubicsAreTheExactCurves) {
+  std::mt19937_64 rng(5);
+  PatchSet set = RandomPatches(rng);
+  const PatchSet curves = ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/hermite-chain.json");
+  set.curves = curves.curves;
+  for (int dims : {2, 3}) {
+    const Toolpath path =
+        BuildToolpath(set, Options("-20,10", 0.05, dims, StepMode::kAdaptive), "mm");
+    std::size_t from_curves = 0;
+    for (const Stroke& s : path.strokes) {
+      ASSERT_EQ(s.cubics.size(), 1u);
+      if (s.curve >= 0) ++from_curves;
+      for (int k = 0; k <= 32; ++k) {
+        const double u = k / 32.0;
+        const auto exact = ExactStrokePoint(set, path, s, u);
+        EXPECT_LT(Distance(BezierAt(s.cubics[0], u), exact), 1e-9) << s.patch << " " << u;
+      }
+    }
+    EXPECT_EQ(from_curves, set.curves.size());
+  }
+}
+
+// Planning keeps each layer's strokes together and the layers in order, and
+// keeps every stroke's cubics a chain from its first point to its last
+// (joined in order, reversed with the stroke).
+TEST(Toolpath, PlanningKeepsLayersApartAndCubicsInStep) {
+  PatchSet set = Teapot();
+  set.layers = {"body", "curves", "again"};
+  const PatchSet chains = ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/hermite-chain.json");
+  for (int layer : {2, 1}) {  // the same curves on two layers, listed last layer first
+    for (Curve c : chains.curves) {
+      c.layer = layer;
+      set.curves.push_back(c);
+    }
+  }
+  ToolpathOptions o = Options("top", 0.05, 2, StepMode::kAdaptive);
+  o.fit = std::array<double, 2>{200, 150};
+  Toolpath path = BuildToolpath(set, o, "mm");
+  PlanStrokes(set, &path);
+  std::vector<int> layers;
+  for (const Stroke& s : path.strokes) {
+    if (layers.empty() || layers.back() != s.layer) layers.push_back(s.layer);
+  }
+  EXPECT_EQ(layers, (std::vector<int>{0, 1, 2}));  // each once, in order
+  std::size_t on_layer[3] = {0, 0, 0};
+  for (const Stroke& s : path.strokes) on_layer[s.layer] += s.cubics.size();
+  EXPECT_EQ(on_layer[1], chains.curves.size());  // not removed as drawn twice by layer 2
+  EXPECT_EQ(on_layer[2], chains.curves.size());
+  const double q = path.quantum.value();
+  const auto at = [&](const std::array<std::int64_t, 3>& p) {
+    return std::array<double, 3>{p[0] * q, p[1] * q, 0};
+  };
+  for (const Stroke& s : path.strokes) {
+    ASSERT_FALSE(s.cubics.empty());
+    EXPECT_LE(Distance(s.cubics.front()[0], at(s.points.front())), 0.05);
+    EXPECT_LE(Distance(s.cubics.back()[3], at(s.points.back())), 0.05);
+    for (std::size_t k = 1; k < s.cubics.size(); ++k) {
+      EXPECT_LE(Distance(s.cubics[k - 1][3], s.cubics[k][0]), 1e-6);
+    }
+  }
+}
+
 TEST(Toolpath, ViewsAreRotations) {
   const auto top = ViewNamed("top");
   EXPECT_EQ(top.right, (std::array<double, 3>{1, 0, 0}));

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -211,6 +212,202 @@ TEST(WriteGcode, ThreeDPlungesToTheFirstDepthAndCarriesZ) {
   EXPECT_EQ(WriteGcode(ThreeDPath(), GcodeOptions{}, {}), expected);
   // In 3-D the pen is the Z axis whatever --pen says.
   EXPECT_EQ(WriteGcode(ThreeDPath(), GcodeOptions{.pen = "m3"}, {}), expected);
+}
+
+// ---- G-code flavours
+
+// One 2-D stroke on a 0.01 mm grid with its exact cubic: Bézier (1, 1),
+// (1.004, 2.996), (3, 3), (3, 1) mm. Rounded to 0.01 mm the control points
+// are (1, 1), (1, 3), (3, 3), (3, 1), so G5 prints I0 J2 (first control point
+// − start) and P0 Q2 (second control point − end). Two layers, one stroke each.
+Toolpath CubicPath() {
+  Toolpath path;
+  path.dims = 2;
+  path.units = "mm";
+  path.quantum = Quantum::Parse("0.01");
+  path.width = 5;
+  path.height = 5;
+  path.tolerance = 0.05;
+  path.layers = {"black", "red"};
+  Stroke arch = MakeStroke({{100, 100, 0}, {200, 280, 0}, {300, 100, 0}});
+  arch.cubics.push_back({{{1, 1, 0}, {1.004, 2.996, 0}, {3, 3, 0}, {3, 1, 0}}});
+  path.strokes.push_back(arch);
+  Stroke line = MakeStroke({{300, 100, 0}, {400, 100, 0}});
+  line.layer = 1;
+  path.strokes.push_back(line);  // no cubics: G1 whatever the flavour
+  return path;
+}
+
+TEST(WriteGcode, MarlinWritesG5MillisecondDwellsServoPenAndPausesBetweenLayers) {
+  const GcodeOptions options{.flavor = "marlin",
+                             .pen = "servo",
+                             .servo_up = 70,
+                             .servo_down = 20,
+                             .servo_index = 1,
+                             .feed = 600,
+                             .travel_rate = 1200,
+                             .dwell = 0.25};
+  // Time by hand: pen-down 2·√(1 + 1.8²) + 1 = 5.118 mm at 600 mm/min
+  // (0.512 s); travel √2 + 0 + √17 = 5.537 mm at 1200 mm/min (0.277 s);
+  // 5 dwells of 0.25 s (1.25 s): 2.04 s → 0:00:02.
+  const std::string expected =
+      "; marlin\n"
+      "; flavor marlin, cubics as G5, dwell G4 P in milliseconds\n"
+      "; estimated time 0:00:02 (pen-down length / feed + travel / 1200 mm/min + plunges + "
+      "dwells)\n"
+      "G21 ; units: mm\n"
+      "G90 ; absolute positions\n"
+      "M280 P1 S70\n"
+      "G4 P250\n"
+      "; layer 'black'\n"
+      "G0 X1.00 Y1.00\n"
+      "M280 P1 S20\n"
+      "G4 P250\n"
+      "G5 I0.00 J2.00 P0.00 Q2.00 X3.00 Y1.00 F600\n"
+      "M280 P1 S70\n"
+      "G4 P250\n"
+      "; pen change: layer 'red'\n"
+      "M0\n"
+      "G0 X3.00 Y1.00\n"
+      "M280 P1 S20\n"
+      "G4 P250\n"
+      "G1 X4.00 Y1.00 F600\n"
+      "M280 P1 S70\n"
+      "G4 P250\n"
+      "G0 X0 Y0\n"
+      "M2\n";
+  EXPECT_EQ(WriteGcode(CubicPath(), options, {"marlin"}), expected);
+}
+
+TEST(WriteGcode, LinuxCncSelectsG17AndUsesParenthesisComments) {
+  // Time: 0.512 s drawing, 5.537 mm at 3000 mm/min (0.111 s), 5 dwells of
+  // 0.5 s: 3.12 s → 0:00:03.
+  const GcodeOptions options{
+      .flavor = "linuxcnc", .pen = "m3", .feed = 600, .dwell = 0.5, .power = 100};
+  const std::string expected =
+      "(source: a [b])\n"
+      "(flavor linuxcnc, cubics as G5, dwell G4 P in seconds)\n"
+      "(estimated time 0:00:03 [pen-down length / feed + travel / 3000 mm/min + plunges + "
+      "dwells])\n"
+      "G21 (units: mm)\n"
+      "G90 (absolute positions)\n"
+      "G17 (XY plane, for G5)\n"
+      "M5\n"
+      "G4 P0.5\n"
+      "(layer 'black')\n"
+      "G0 X1.00 Y1.00\n"
+      "M3 S100\n"
+      "G4 P0.5\n"
+      "G5 I0.00 J2.00 P0.00 Q2.00 X3.00 Y1.00 F600\n"
+      "M5\n"
+      "G4 P0.5\n"
+      "(pen change: layer 'red')\n"
+      "M0\n"
+      "G0 X3.00 Y1.00\n"
+      "M3 S100\n"
+      "G4 P0.5\n"
+      "G1 X4.00 Y1.00 F600\n"
+      "M5\n"
+      "G4 P0.5\n"
+      "G0 X0 Y0\n"
+      "M2\n";
+  EXPECT_EQ(WriteGcode(CubicPath(), options, {"source: a (b)"}), expected);
+}
+
+TEST(WriteGcode, GrblDrawsTheCubicAsItsSegmentsWithSecondDwells) {
+  // Time: 0.512 s drawing, 0.111 s travel, 2 plunges of 5 mm at 300 mm/min
+  // (2 s), 2 lifts of 5 mm at 3000 mm/min (0.2 s): 2.82 s → 0:00:03.
+  const GcodeOptions options{.flavor = "grbl", .feed = 600};
+  const std::string expected =
+      "(flavor grbl, cubics as G1 segments, dwell G4 P in seconds)\n"
+      "(estimated time 0:00:03 [pen-down length / feed + travel / 3000 mm/min + plunges + "
+      "dwells])\n"
+      "G21 (units: mm)\n"
+      "G90 (absolute positions)\n"
+      "G0 Z5\n"
+      "(layer 'black')\n"
+      "G0 X1.00 Y1.00\n"
+      "G1 Z0 F300\n"
+      "G1 X2.00 Y2.80 F600\n"
+      "G1 X3.00 Y1.00\n"
+      "G0 Z5\n"
+      "(pen change: layer 'red')\n"
+      "M0\n"
+      "G0 X3.00 Y1.00\n"
+      "G1 Z0 F300\n"
+      "G1 X4.00 Y1.00 F600\n"
+      "G0 Z5\n"
+      "G0 X0 Y0\n"
+      "M2\n";
+  EXPECT_EQ(WriteGcode(CubicPath(), options, {}), expected);
+  // Marlin without G5 writes the same segments (with ; comments).
+  const std::string marlin =
+      WriteGcode(CubicPath(), GcodeOptions{.flavor = "marlin", .feed = 600, .g5 = false}, {});
+  EXPECT_NE(marlin.find("G1 X2.00 Y2.80 F600\nG1 X3.00 Y1.00\n"), std::string::npos);
+  EXPECT_EQ(marlin.find("G5"), std::string::npos);
+}
+
+TEST(WriteGcode, RefusesServoWithoutM280AndUnknownFlavours) {
+  EXPECT_THROW(WriteGcode(CubicPath(), GcodeOptions{.flavor = "grbl", .pen = "servo"}, {}),
+               OptionError);
+  EXPECT_THROW(WriteGcode(CubicPath(), GcodeOptions{.flavor = "generic", .pen = "servo"}, {}),
+               OptionError);
+  EXPECT_THROW(WriteGcode(CubicPath(), GcodeOptions{.flavor = "reprap"}, {}), OptionError);
+}
+
+TEST(WriteGcode, RefusesG5WhoseRoundedControlPointsBreakTheTolerance) {
+  // The first control point (1.004, 2.996) is printed as (1.00, 3.00): 0.0057 mm
+  // away. Within a 0.0057 mm tolerance the convex-hull bound is not met.
+  Toolpath path = CubicPath();
+  path.tolerance = 0.0056;
+  EXPECT_THROW(WriteGcode(path, GcodeOptions{.flavor = "marlin"}, {}), OptionError);
+  path.tolerance = 0.0057;
+  EXPECT_NO_THROW(WriteGcode(path, GcodeOptions{.flavor = "marlin"}, {}));
+}
+
+TEST(WriteGcode, GenericIgnoresCubicsAndNamesLayersWithSemicolons) {
+  const std::string out = WriteGcode(CubicPath(), GcodeOptions{}, {});
+  EXPECT_EQ(out.find("G5"), std::string::npos);
+  EXPECT_EQ(out.find("estimated"), std::string::npos);  // generic: no new header lines
+  EXPECT_NE(out.find("G0 Z5\n; pen change: layer 'red'\nM0\nG0 X3.00 Y1.00\n"), std::string::npos);
+}
+
+TEST(EstimateGcodeSeconds, AddsDrawingTravelPlungesAndLifts) {
+  // MillimetrePath, Z pen: strokes 2·√(1.5² + 2²) = 5.0 mm and
+  // √(10.25² + 0.001²) mm at F1500; travel 0 +
+  // |(3,0)→(−0.25,4.999)| + |(10,5)→(0,0)| at 3000; plunges 2×5 mm at F300,
+  // lifts 2×5 mm at 3000.
+  const double down = 5.0 + std::hypot(10.25, 0.001);
+  const double travel = std::hypot(3.25, 4.999) + std::hypot(10.0, 5.0) + 10.0;
+  const double expected = 60 * (down / 1500 + travel / 3000 + 10.0 / 300);
+  EXPECT_NEAR(EstimateGcodeSeconds(MillimetrePath(), GcodeOptions{}), expected, 1e-9);
+  // M3: no Z moves, five dwells (one initial lift, two per stroke).
+  const double m3 = 60 * (down / 1500 + (travel - 10.0) / 3000) + 5 * 0.2;
+  EXPECT_NEAR(EstimateGcodeSeconds(MillimetrePath(), GcodeOptions{.pen = "m3"}), m3, 1e-9);
+}
+
+// ---- SVG layers
+
+TEST(WriteSvg, LayersBecomeInkscapeLayerGroups) {
+  const std::string expected =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" "
+      "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" version=\"1.1\" "
+      "width=\"5.00mm\" height=\"5.00mm\" viewBox=\"0 0 5.00 5.00\">\n"
+      "<title>layers</title>\n"
+      "<g fill=\"none\" stroke=\"black\" stroke-width=\"0.25\" stroke-linecap=\"round\" "
+      "stroke-linejoin=\"round\">\n"
+      "<g inkscape:groupmode=\"layer\" inkscape:label=\"black\">\n"
+      "<path d=\"M1.00 4.00 L2.00 2.20 L3.00 4.00\"/>\n"
+      "</g>\n"
+      "<g inkscape:groupmode=\"layer\" inkscape:label=\"red &amp; blue\">\n"
+      "<path d=\"M3.00 4.00 L4.00 4.00\"/>\n"
+      "</g>\n"
+      "</g>\n"
+      "</svg>\n";
+  Toolpath path = CubicPath();
+  path.layers[1] = "red & blue";
+  EXPECT_EQ(WriteSvg(path, "layers"), expected);
 }
 
 // ---- HPGL

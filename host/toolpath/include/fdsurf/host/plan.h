@@ -94,7 +94,11 @@ struct PlanReport {
 /// curve drawn already (DrawnCurves), joins strokes that meet end to end,
 /// orders them by nearest neighbour from the origin (reversing where it
 /// helps) and improves the order by 2-opt. Distances are in the drawing
-/// plane. Joined strokes lose their params (they span several curves).
+/// plane. Joined strokes lose their params (they span several curves) and
+/// keep their cubics in order (reversed with the stroke). Each layer
+/// (Stroke::layer) is planned on its own, layers in ascending order, the
+/// next starting where the last left the pen: nothing is joined, removed or
+/// reordered across layers.
 PlanReport PlanStrokes(const PatchSet& set, Toolpath* path);
 
 }  // namespace fdsurf::host

@@ -99,6 +99,16 @@ struct Stroke {
   std::ptrdiff_t curve = -1;
   /// Fixed parameter of the isoline (s for s-lines, t for t-lines).
   double line_param = 0;
+  /// Index into Toolpath::layers (the curve's PatchSet layer; 0 for the
+  /// isolines of patches and when the drawing has no layers).
+  int layer = 0;
+  /// The exact cubic pieces the stroke draws, in order, each as its four
+  /// Bézier control points in output units (the mapped, unrounded curve;
+  /// z = 0 in 2-D). The first piece starts near points.front() and the last
+  /// ends near points.back(), each within the tolerance. Empty when unknown:
+  /// code that cuts a stroke's points (or joins it to one without cubics)
+  /// must clear it or cut the cubics too, or G5 output would draw the cut part.
+  std::vector<std::array<std::array<double, 3>, 4>> cubics;
 };
 
 struct Toolpath {
@@ -112,6 +122,11 @@ struct Toolpath {
   /// The drawing's extent along the view's depth, output units (3-D output
   /// puts its top at Z = 0 and its bottom at Z = -depth).
   double depth = 0;
+  /// The largest distance promised between a stroke and its exact curve,
+  /// output units (ToolpathOptions::tolerance); 0 when unknown.
+  double tolerance = 0;
+  /// The layers' names (PatchSet::layers); empty: one unnamed layer.
+  std::vector<std::string> layers;
   std::vector<Stroke> strokes;
 };
 
@@ -135,12 +150,17 @@ void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quan
 void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
                    CurveGeometry1* geometry);
 
-/// Draws every patch's isolines, then the file's curves. Throws as PlanPage
+/// Draws every patch's isolines, then the file's curves, each stroke with its
+/// layer and its exact cubic (Stroke::cubics). Throws as PlanPage
 /// for options that cannot be met (tolerance below the quantum's reach, a
 /// drawing that does not fit) and EngineError when the engine refuses a
 /// curve. `progress`, when set, is called after each patch.
 Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
                        const std::string& units, const Progress& progress = {});
+
+/// The Bézier control points of a cubic given by its power coefficients
+/// (ascending: power[k] multiplies u^k), exact up to double rounding.
+std::array<Point3, 4> BezierFromPower(const std::array<Point3, 4>& power);
 
 /// The exact point of an isoline in output units (the double reference,
 /// through the same map), for checks.

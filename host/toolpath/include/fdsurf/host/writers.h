@@ -13,28 +13,55 @@
 namespace fdsurf::host {
 
 /// SVG 1.1: a page of width × height output units (mm or in), one <path> per
-/// stroke, y flipped so that up in the drawing is up on the page.
+/// stroke, y flipped so that up in the drawing is up on the page. When the
+/// toolpath has layers, each run of strokes of one layer is an Inkscape
+/// layer group (<g inkscape:groupmode="layer" inkscape:label="NAME">).
 std::string WriteSvg(const Toolpath& path, const std::string& title);
 
 struct GcodeOptions {
-  /// "z": pen up/down (or the plunge in 3-D) as Z moves; "m3": M3/M5 with a dwell.
+  /// The machine's dialect: "generic" (what fdsurf always wrote), "grbl",
+  /// "marlin" or "linuxcnc"; docs/toolpaths.md has the table of differences.
+  std::string flavor = "generic";
+  /// "z": pen up/down (or the plunge in 3-D) as Z moves; "m3": M3/M5 with a
+  /// dwell; "servo": Marlin's M280 P<servo_index> S<angle> with a dwell.
   std::string pen = "z";
   double pen_up_z = 5;
   double pen_down_z = 0;
+  /// Servo angles (degrees) for the pen up and down, and the servo's index.
+  double servo_up = 90;
+  double servo_down = 30;
+  int servo_index = 0;
   /// Drawing and plunge feed rates, output units per minute.
   double feed = 1500;
   double plunge_feed = 300;
-  /// Dwell after M3/M5, seconds.
+  /// The rate assumed for G0 travel in the time estimate (the machine's own
+  /// rapid rate is not known here), output units per minute.
+  double travel_rate = 3000;
+  /// Dwell after M3/M5 and after each servo move, seconds.
   double dwell = 0.2;
   /// M3 spindle/laser power word.
   int power = 1000;
+  /// Strokes with exact cubics as G5 where the flavour has G5 (marlin,
+  /// linuxcnc) and the output is 2-D; false: G1 segments everywhere.
+  bool g5 = true;
 };
 
-/// G-code: G21/G20, G90; G0 for travel, G1 with feed for drawing. In 3-D the
-/// Z of each point is the surface's depth and travel happens at pen_up_z.
-/// `header` lines become leading comments.
+/// G-code: G21/G20, G90; G0 for travel, G1 with feed for drawing (or G5
+/// cubics, see GcodeOptions::g5). In 3-D the Z of each point is the
+/// surface's depth and travel happens at pen_up_z. `header` lines become
+/// leading comments; every flavour but generic adds its name and the
+/// estimated machine time. Between layers: the pen lifted, a comment naming
+/// the next layer and M0. Throws OptionError ("pen") for a flavour or pen
+/// that is not known, or servo with a flavour without M280, and
+/// OptionError ("tolerance") when a G5's control points, printed at the
+/// quantum, would move the curve further than path.tolerance.
 std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
                        const std::vector<std::string>& header);
+
+/// The estimated machine time of WriteGcode's program, seconds: pen-down
+/// length / feed + travel (G0, pen lifts) / travel_rate + plunges /
+/// plunge_feed + dwells (docs/toolpaths.md, "Time estimate").
+double EstimateGcodeSeconds(const Toolpath& path, const GcodeOptions& options);
 
 /// HPGL: IN; SP1; PU/PD with absolute plotter units. Requires the toolpath's
 /// quantum to be the plotter unit (0.025 mm), so every point is exact.
