@@ -197,7 +197,6 @@ Block Interpreter::Sort(const Line& line) const {
       (word.letter == 'G' ? block.g : block.m).push_back(Tenths(word.value));
       continue;
     }
-    if (word.letter == 'O') throw Error(line.number, "O-word subroutines are not supported");
     if (!block.words.emplace(word.letter, word).second) {
       throw Error(line.number, std::string("word '") + word.letter + "' given twice");
     }

@@ -88,6 +88,8 @@ class LineScanner {
         ++i;
       } else if (c == '#' || c == '[') {
         throw Error(std::string("'") + c + "': parameters and expressions are not supported");
+      } else if (c == 'O' || c == 'o') {
+        throw Error("O-word subroutines are not supported");
       } else if (std::isalpha(static_cast<unsigned char>(c)) != 0) {
         Word word = ReadWord(body, &i);
         if (word.letter != 'N') line->words.push_back(std::move(word));
