@@ -152,6 +152,23 @@ std::vector<Stroke> JoinTouching(std::vector<Stroke> strokes) {
   return joined;
 }
 
+// For a set whose order is the user's (PatchSet::keep_order, a G-code
+// program): only strokes that already meet one after the other are joined;
+// nothing is reordered, reversed or left out.
+std::vector<Stroke> JoinInSequence(std::vector<Stroke> strokes) {
+  std::vector<Stroke> joined;
+  for (Stroke& stroke : strokes) {
+    if (!joined.empty() && joined.back().points.back() == stroke.points.front()) {
+      Stroke& chain = joined.back();
+      chain.points.insert(chain.points.end(), stroke.points.begin() + 1, stroke.points.end());
+      chain.params.clear();  // a joined stroke spans several curves
+    } else {
+      joined.push_back(std::move(stroke));
+    }
+  }
+  return joined;
+}
+
 // 3. Nearest neighbour from the origin, reversing where it helps.
 std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes) {
   std::vector<std::array<PlanPoint, 2>> ends;
@@ -274,11 +291,15 @@ PlanReport PlanStrokes(const PatchSet& set, Toolpath* path) {
   report.pen_down_before = down_before * q;
   report.pen_up_before = up_before * q;
 
-  std::vector<Stroke> strokes =
-      RemoveDrawnTwice(set, *path, std::move(path->strokes), &report.duplicates_removed);
-  strokes = OrderStrokes(JoinTouching(std::move(strokes)));
-  ImproveByTwoOpt(&strokes);
-  path->strokes = std::move(strokes);
+  if (set.keep_order) {
+    path->strokes = JoinInSequence(std::move(path->strokes));
+  } else {
+    std::vector<Stroke> strokes =
+        RemoveDrawnTwice(set, *path, std::move(path->strokes), &report.duplicates_removed);
+    strokes = OrderStrokes(JoinTouching(std::move(strokes)));
+    ImproveByTwoOpt(&strokes);
+    path->strokes = std::move(strokes);
+  }
 
   report.strokes_after = path->strokes.size();
   const auto [down_after, up_after] = PenLengths(path->strokes);
