@@ -84,8 +84,8 @@ std::string IgnoredGReason(int g) {
 // The words of one line, sorted for the interpreter.
 struct Block {
   int line = 0;
-  std::vector<int> g;  // tenths
-  std::vector<int> m;  // tenths
+  std::vector<int> g;          // tenths
+  std::vector<int> m;          // tenths
   std::map<char, Word> words;  // every other letter, at most once
 
   [[nodiscard]] bool Has(char letter) const { return words.count(letter) != 0; }
@@ -127,7 +127,7 @@ class Interpreter {
   }
   void Note(const std::string& key, int line, const std::string& what);
 
-  Block Sort(const Line& line) const;
+  [[nodiscard]] Block Sort(const Line& line) const;
   void ScanPenMechanisms(const std::vector<Line>& lines);
   bool Execute(const Block& block);  // false at M2/M30
   void SetModes(const Block& block);
@@ -137,14 +137,14 @@ class Interpreter {
 
   double Length(double value, int line);
   Axes AxisWords(const Block& block);
-  Point3 Target(const Axes& axes) const;
+  [[nodiscard]] Point3 Target(const Axes& axes) const;
   [[nodiscard]] bool PenDownAt(const Point3& machine, bool z_known) const;
 
   void Move(const Block& block, int motion, const Point3& target, bool z_known_after);
   void Arc(const Block& block, bool clockwise, const Point3& target, bool drawn);
   void AddArcPieces(int line, const std::string& code, const PlaneAxes& p,
-                    const std::array<double, 2>& centre, double radius, double start,
-                    double sweep, const Point3& target);
+                    const std::array<double, 2>& centre, double radius, double start, double sweep,
+                    const Point3& target);
   void Cubic(const Block& block, const Point3& target, bool drawn);
   void Quadratic(const Block& block, const Point3& target, bool drawn);
   void AddCurve(const std::array<Point3, 4>& g, int line, const std::string& code, bool straight);
@@ -290,8 +290,8 @@ void Interpreter::PenCommands(const Block& block) {
       }
       case 60: {
         const std::optional<double> tool = block.Get('T');
-        NewLayer(tool ? "T" + FormatNumber(*tool) : "tool change at line " +
-                                                         std::to_string(block.line));
+        NewLayer(tool ? "T" + FormatNumber(*tool)
+                      : "tool change at line " + std::to_string(block.line));
         break;
       }
       case 0:
@@ -337,8 +337,8 @@ bool Interpreter::Execute(const Block& block) {
   }
   for (const char axis : {'A', 'B', 'C', 'U', 'V', 'W'}) {
     if (block.Has(axis)) {
-      throw Error(block.line, std::string("word '") + axis +
-                                  "': only the X, Y and Z axes are supported");
+      throw Error(block.line,
+                  std::string("word '") + axis + "': only the X, Y and Z axes are supported");
     }
   }
   if (block.Has('E')) Note("E", block.line, "E (extrusion) words ignored");
@@ -346,8 +346,8 @@ bool Interpreter::Execute(const Block& block) {
   PenCommands(block);
   if (motion_on_line >= 0) motion_ = motion_on_line;
   if (axis_command >= 0 && motion_on_line >= 0) {
-    throw Error(block.line, CodeName('G', axis_command) + " and " +
-                                CodeName('G', motion_on_line) + " on one line");
+    throw Error(block.line, CodeName('G', axis_command) + " and " + CodeName('G', motion_on_line) +
+                                " on one line");
   }
   if (axis_command >= 0) {
     AxisCommand(block);
@@ -418,8 +418,9 @@ void Interpreter::AxisCommand(const Block& block) {
     if (axes[2]) z_known_ = true;
     return;
   }
-  Note("G28", block.line, "G28: home is taken as where the program started (0, 0, 0); " +
-                              std::string("the move there is travel"));
+  Note("G28", block.line,
+       "G28: home is taken as where the program started (0, 0, 0); " +
+           std::string("the move there is travel"));
   position_ = {0, 0, 0};
   z_known_ = true;
 }
@@ -434,8 +435,8 @@ bool Interpreter::PenDownAt(const Point3& machine, bool z_known) const {
 
 void Interpreter::Move(const Block& block, int motion, const Point3& target, bool z_known_after) {
   const bool any_pen = uses_spindle_ || uses_servo_ || uses_z_;
-  const bool drawn = any_pen ? PenDownAt(position_, z_known_) && PenDownAt(target, z_known_after)
-                             : motion != 0;
+  const bool drawn =
+      any_pen ? PenDownAt(position_, z_known_) && PenDownAt(target, z_known_after) : motion != 0;
   if (motion == 50) {
     Cubic(block, target, drawn);
   } else {
@@ -481,8 +482,8 @@ void Interpreter::NewLayer(const std::string& name) {
 // 180°), to the left for a counter-clockwise one; R < 0 takes the other side
 // (the arc over 180°). Grbl's wiki and LinuxCNC's reference give this rule.
 std::array<double, 2> CentreFromRadius(double sa, double sb, double ea, double eb, double r,
-                                       bool clockwise, const std::function<InputError(
-                                                           const std::string&)>& fail) {
+                                       bool clockwise,
+                                       const std::function<InputError(const std::string&)>& fail) {
   const double da = ea - sa;
   const double db = eb - sb;
   const double d = std::hypot(da, db);
@@ -521,8 +522,7 @@ void Interpreter::Arc(const Block& block, bool clockwise, const Point3& target, 
     if (closed) {
       throw fail("R with the end point at the start (a full circle needs " + offset_names + ")");
     }
-    centre = CentreFromRadius(sa, sb, ea, eb, Length(*block.Get('R'), block.line), clockwise,
-                              fail);
+    centre = CentreFromRadius(sa, sb, ea, eb, Length(*block.Get('R'), block.line), clockwise, fail);
   } else {
     const auto offset = [&](char letter, std::size_t axis, double start) {
       const std::optional<double> value = block.Get(letter);
@@ -598,8 +598,8 @@ void Interpreter::AddArcPieces(int line, const std::string& code, const PlaneAxe
     RationalQuadratic piece;
     piece.p0 = from;
     piece.p1 = at(start + step * (k + 0.5), lin0 + (lin1 - lin0) * (f0 + f1) / 2, radius / w);
-    piece.p2 = k + 1 == pieces ? target : at(start + step * (k + 1), lin0 + (lin1 - lin0) * f1,
-                                              radius);
+    piece.p2 =
+        k + 1 == pieces ? target : at(start + step * (k + 1), lin0 + (lin1 - lin0) * f1, radius);
     piece.w = w;
     try {
       for (const CubicArc& cubic : ArcToCubics(piece, options_.arc_tolerance)) {
@@ -698,8 +698,7 @@ bool IsGcodePath(const std::string& path) {
   if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return false;
   std::string suffix = path.substr(dot + 1);
   for (char& c : suffix) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return suffix == "gcode" || suffix == "nc" || suffix == "ngc" || suffix == "g" ||
-         suffix == "gco";
+  return suffix == "gcode" || suffix == "nc" || suffix == "ngc" || suffix == "g" || suffix == "gco";
 }
 
 }  // namespace fdsurf::host

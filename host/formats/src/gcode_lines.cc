@@ -41,7 +41,7 @@ class LineScanner {
   }
 
   // Checks a Marlin checksum `*N` at `star` and returns the text before it.
-  std::string_view CheckChecksum(std::size_t star) const {
+  [[nodiscard]] std::string_view CheckChecksum(std::size_t star) const {
     unsigned sum = 0;
     for (std::size_t i = 0; i < star; ++i) sum ^= static_cast<unsigned char>(text_[i]);
     std::size_t i = star + 1;

@@ -226,8 +226,8 @@ TEST(GcodeMotion, G28TravelsHome) {
 }
 
 TEST(GcodeMotion, EndAndIgnoredCodes) {
-  const PatchSet set = Read(
-      "G21 G17 G90 G94 G64 G54 M8\nG4 P0.5\nG1 X1 F100 S200\nG64\nM2\nG1 X50\n");
+  const PatchSet set =
+      Read("G21 G17 G90 G94 G64 G54 M8\nG4 P0.5\nG1 X1 F100 S200\nG64\nM2\nG1 X50\n");
   ASSERT_EQ(set.curves.size(), 1u);
   EXPECT_EQ(CountNotes(set, "p.gcode:1: G64 ignored"), 1u);  // once, with its first line
   EXPECT_EQ(CountNotes(set, "G64"), 1u);
@@ -248,7 +248,8 @@ TEST(GcodeMotion, CodesThatMoveAreRefused) {
   EXPECT_EQ(ReadError("G12 X1\n"), "p.gcode:1: G12: not supported (an unknown G code may move)");
   EXPECT_EQ(ReadError("G1 A10\n"), "p.gcode:1: word 'A': only the X, Y and Z axes are supported");
   EXPECT_EQ(ReadError("G0 G1 X1\n"), "p.gcode:1: two motion codes, G0 and G1, on one line");
-  EXPECT_EQ(ReadError("G1 X1 I2\n"), "p.gcode:1: word 'I': no G2, G3, G5 or G5.1 on the line to use it");
+  EXPECT_EQ(ReadError("G1 X1 I2\n"),
+            "p.gcode:1: word 'I': no G2, G3, G5 or G5.1 on the line to use it");
 }
 
 // ---- pen ---------------------------------------------------------------------
@@ -403,8 +404,8 @@ TEST(GcodeSplines, QuadraticIsRaisedExactly) {
   for (int k = 0; k <= 10; ++k) {
     const double t = k / 10.0;
     const double u = 1 - t;
-    const Point3 want = {u * u * 1 + 2 * t * u * 4 + t * t * 7, u * u * 1 + 2 * t * u * 7 + t * t * 1,
-                         0};
+    const Point3 want = {u * u * 1 + 2 * t * u * 4 + t * t * 7,
+                         u * u * 1 + 2 * t * u * 7 + t * t * 1, 0};
     ExpectPoint(Bezier(set.curves[0], t), want, 1e-13, "t=" + std::to_string(t));
   }
   EXPECT_EQ(ReadError("G5.1 X1 Y1\n"), "p.gcode:1: G5.1: I and J are both zero or missing");
@@ -414,12 +415,12 @@ TEST(GcodeSplines, QuadraticIsRaisedExactly) {
 
 TEST(GcodeLayers, ToolChangesAndPauses) {
   const PatchSet set = Read(
-      "G1 X1\n"         // 1: "start"
-      "T2 M6\n"         // 2
-      "G1 X2\n"         // 3: "T2"
-      "M0\n"            // 4
-      "M1\n"            // 5: an empty layer, left out
-      "G1 X3\n");       // 6: "after M1 at line 5"
+      "G1 X1\n"    // 1: "start"
+      "T2 M6\n"    // 2
+      "G1 X2\n"    // 3: "T2"
+      "M0\n"       // 4
+      "M1\n"       // 5: an empty layer, left out
+      "G1 X3\n");  // 6: "after M1 at line 5"
   EXPECT_EQ(set.layers, (std::vector<std::string>{"start", "T2", "after M1 at line 5"}));
   ASSERT_EQ(set.curves.size(), 3u);
   EXPECT_EQ(set.curves[0].layer, 0);

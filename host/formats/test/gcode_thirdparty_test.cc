@@ -60,7 +60,8 @@ double AngleDifference(double a, double b) {
 TEST(GcodeThirdParty, LinuxCncTortureArcsMatchTheirStatedAngles) {
   const std::string path = Dir() + "/tort.ngc";
   const std::string text = Slurp(path);
-  ASSERT_FALSE(text.empty()) << "no " << path << " (run tests/thirdparty/fetch_linuxcnc_ncfiles.sh)";
+  ASSERT_FALSE(text.empty()) << "no " << path
+                             << " (run tests/thirdparty/fetch_linuxcnc_ncfiles.sh)";
   GcodeReadOptions options;
   options.pen_z_threshold = 1e9;  // draw every move: the arcs are what is checked
   const PatchSet set = ReadGcode(text, "tort.ngc", options);
@@ -110,8 +111,11 @@ TEST(GcodeThirdParty, LinuxCncTortureArcsMatchTheirStatedAngles) {
     // I, K and end point are at 165° and 315° from X): for G18 only the
     // circle itself is checked.
     const bool comment_usable = plane != 18;
-    if (comment_usable) EXPECT_LT(AngleDifference(angle(start), start_deg), 1.01) << "line " << number << ": " << line;
-    if (comment_usable) EXPECT_LT(AngleDifference(angle(end), end_deg), 1.01) << "line " << number << ": " << line;
+    if (comment_usable)
+      EXPECT_LT(AngleDifference(angle(start), start_deg), 1.01)
+          << "line " << number << ": " << line;
+    if (comment_usable)
+      EXPECT_LT(AngleDifference(angle(end), end_deg), 1.01) << "line " << number << ": " << line;
     double turned = 0;
     double previous = angle(start);
     for (const Curve* c : curves) {
