@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "construct_io.h"
+#include "fdsurf/host/gcode_io.h"
 
 namespace fdsurf::host {
 namespace {
@@ -313,6 +314,7 @@ PatchSet ReadPatchFile(const std::string& path) {
   buffer << in.rdbuf();
   if (in.bad()) throw InputError(path + ": read error");
   const std::string text = buffer.str();
+  if (IsGcodePath(path)) return ReadGcode(text, path);
   if (EndsWith(path, ".json")) return ParseJson(text, path);
   if (EndsWith(path, ".bpt")) return ParseBpt(text, path);
   const std::size_t first = text.find_first_not_of(" \t\r\n");

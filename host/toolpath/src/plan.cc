@@ -165,6 +165,22 @@ std::vector<Stroke> JoinTouching(std::vector<Stroke> strokes) {
   return joined;
 }
 
+// For a set whose order is the user's (PatchSet::keep_order, a G-code
+// program): only strokes that already meet one after the other are joined;
+// nothing is reordered, reversed or left out.
+std::vector<Stroke> JoinInSequence(std::vector<Stroke> strokes) {
+  std::vector<Stroke> joined;
+  for (Stroke& stroke : strokes) {
+    if (!joined.empty() && joined.back().points.back() == stroke.points.front()) {
+      Append(&joined.back(), stroke);
+      joined.back().params.clear();  // a joined stroke spans several curves
+    } else {
+      joined.push_back(std::move(stroke));
+    }
+  }
+  return joined;
+}
+
 // 3. Nearest neighbour from `start`, reversing where it helps.
 std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes, const PlanPoint& start) {
   std::vector<std::array<PlanPoint, 2>> ends;
@@ -298,14 +314,19 @@ PlanReport PlanStrokes(const PatchSet& set, Toolpath* path) {
 
   // Each layer is planned on its own (a pen change lies between layers), in
   // layer order, starting where the layer before it left the pen; nothing is
-  // joined, removed as a duplicate or reordered across layers.
+  // joined, removed as a duplicate or reordered across layers. A program's
+  // order (keep_order) is kept: its strokes are only joined in sequence.
   std::vector<Stroke> planned;
   PlanPoint pen{0, 0, 0};
   for (std::vector<Stroke>& layer : SplitByLayer(std::move(path->strokes))) {
-    std::vector<Stroke> strokes =
-        RemoveDrawnTwice(set, *path, std::move(layer), &report.duplicates_removed);
-    strokes = OrderStrokes(JoinTouching(std::move(strokes)), pen);
-    ImproveByTwoOpt(&strokes, pen);
+    std::vector<Stroke> strokes;
+    if (set.keep_order) {
+      strokes = JoinInSequence(std::move(layer));
+    } else {
+      strokes = RemoveDrawnTwice(set, *path, std::move(layer), &report.duplicates_removed);
+      strokes = OrderStrokes(JoinTouching(std::move(strokes)), pen);
+      ImproveByTwoOpt(&strokes, pen);
+    }
     if (!strokes.empty()) pen = ToPlan(strokes.back().points.back());
     for (Stroke& s : strokes) planned.push_back(std::move(s));
   }

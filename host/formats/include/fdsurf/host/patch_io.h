@@ -11,9 +11,10 @@
 
 namespace fdsurf::host {
 
-/// Reads a BPT or JSON patch file, or an OBJ or PLY triangle mesh drawn as
-/// quadric Hermite pieces (curves; docs/formats.md). The format is taken from
-/// the extension (.bpt, .json; .obj, .ply in any case) or, failing that, from
+/// Reads a BPT or JSON patch file, an OBJ or PLY triangle mesh drawn as
+/// quadric Hermite pieces (curves; docs/formats.md), or a G-code program
+/// (gcode_io.h, default options). The format is taken from the extension
+/// (.bpt, .json; .obj, .ply, .gcode .nc .ngc .g .gco in any case) or, failing that, from
 /// the first non-blank character. Throws InputError on anything malformed or
 /// a mesh the construction refuses.
 PatchSet ReadPatchFile(const std::string& path);
