@@ -135,11 +135,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--size", o->png_width, "PNG width in pixels")
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
-  command
-      ->add_option("--hidden", o->hidden,
-                   "show; remove is for plot and render (the device draws whole isolines)")
-      ->check(CLI::IsMember({"show", "remove"}))
-      ->capture_default_str();
+  command->add_option("--hidden", o->hidden, "show (remove: plot and render only)")
+      ->check(CLI::IsMember({"show", "remove"}));
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 

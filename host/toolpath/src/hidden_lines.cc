@@ -47,7 +47,7 @@ class StrokeVisibility {
       : set_(set), path_(path), stroke_(stroke), occlusion_(occlusion), report_(report) {}
 
   // The exact point at `param` in output space, with its depth (also in 2-D).
-  Vec At(double param) const {
+  FDSURF_NODISCARD Vec At(double param) const {
     Point3 model{};
     if (stroke_.curve >= 0) {
       model = EvaluateCurve(set_.curves[static_cast<std::size_t>(stroke_.curve)], param);
@@ -60,7 +60,7 @@ class StrokeVisibility {
     return path_.map.Apply(model);
   }
 
-  bool Visible(const Vec& point) const {
+  FDSURF_NODISCARD bool Visible(const Vec& point) const {
     ++report_->queries;
     const SurfaceOcclusion::Answer answer = occlusion_.Query(point);
     if (answer.undecided) ++report_->undecided;
@@ -68,7 +68,7 @@ class StrokeVisibility {
   }
 
   // The exact point rounded to the quantum, as the stroke's own points are.
-  StrokePoint Rounded(double param) const {
+  FDSURF_NODISCARD StrokePoint Rounded(double param) const {
     const Vec p = At(param);
     StrokePoint out{};
     for (int c = 0; c < path_.dims; ++c) {
@@ -80,7 +80,7 @@ class StrokeVisibility {
   // Between `visible_param` (visible) and `hidden_param` (hidden): the last
   // visible parameter found by bisection once the two bracketing exact
   // points are within `locate` in the drawing plane.
-  double Locate(double visible_param, double hidden_param, double locate) const {
+  FDSURF_NODISCARD double Locate(double visible_param, double hidden_param, double locate) const {
     Vec visible = At(visible_param);
     Vec hidden = At(hidden_param);
     for (int k = 0; k < kMaxBisections && PlaneDistance(visible, hidden) > locate; ++k) {
@@ -171,8 +171,8 @@ class PieceBuilder {
   bool open_ = false;
 };
 
-void CutStroke(const StrokeVisibility& line, const Stroke& stroke,
-               const HiddenLineOptions& options, std::vector<Stroke>* out) {
+void CutStroke(const StrokeVisibility& line, const Stroke& stroke, const HiddenLineOptions& options,
+               std::vector<Stroke>* out) {
   const std::vector<Sample> samples = SampleStroke(line, stroke, options.spacing);
   PieceBuilder pieces(stroke, out);
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -204,9 +204,9 @@ void CheckOptions(const HiddenLineOptions& options) {
   positive(options.locate, "hidden locate");
   positive(options.spacing, "hidden spacing");
   if (options.spacing < options.locate) {
-    throw OptionError("hidden spacing", FormatNumber(options.spacing),
-                      "must not be below the transition's location (" +
-                          FormatNumber(options.locate) + ")");
+    throw OptionError(
+        "hidden spacing", FormatNumber(options.spacing),
+        "must not be below the transition's location (" + FormatNumber(options.locate) + ")");
   }
 }
 
@@ -240,8 +240,7 @@ HiddenLineReport RemoveHiddenLines(const PatchSet& set, const HiddenLineOptions&
   report.strokes_after = visible.size();
   for (const Stroke& s : visible) report.length_after += DrawnLength(s, quantum);
   path->strokes = std::move(visible);
-  report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 

@@ -134,8 +134,8 @@ PointAndPartials Evaluate(const PowerPatch& power, double s, double t) {
 
 // Newton's method on (right, up)(s, t) = target from (s, t), kept in
 // [0, 1]²: true when it converges to a point more than `depth_limit` deep.
-bool FindWitness(const PowerPatch& power, double s, double t, const Vec& target,
-                 double depth_limit, double residual) {
+bool FindWitness(const PowerPatch& power, double s, double t, const Vec& target, double depth_limit,
+                 double residual) {
   for (int iteration = 0; iteration < 12; ++iteration) {
     const PointAndPartials e = Evaluate(power, s, t);
     const double fx = e.p[0] - target[0];
@@ -268,8 +268,8 @@ void SurfaceOcclusion::Index::Build(const PatchSet& set, const OutputMap& map) {
     }
   }
   const double extent = std::max({all.hi[0] - all.lo[0], all.hi[1] - all.lo[1], eps});
-  const int side = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(pieces.size()))), 1,
-                              256);
+  const int side =
+      std::clamp(static_cast<int>(std::sqrt(static_cast<double>(pieces.size()))), 1, 256);
   cell = extent / side;
   x0 = all.lo[0];
   y0 = all.lo[1];
@@ -291,16 +291,16 @@ void SurfaceOcclusion::Index::Build(const PatchSet& set, const OutputMap& map) {
 }
 
 // Whether `piece` (with its box) holds a witness that hides `point`.
-bool SurfaceOcclusion::Index::Hides(const Piece& piece, const Box& box, const Vec& point,
-                                    int level, bool* undecided) const {
+bool SurfaceOcclusion::Index::Hides(const Piece& piece, const Box& box, const Vec& point, int level,
+                                    bool* undecided) const {
   if (point[0] < box.lo[0] || point[0] > box.hi[0] || point[1] < box.lo[1] ||
       point[1] > box.hi[1]) {
     return false;  // the sub-patch lies beside the line of sight
   }
   const double depth_limit = point[2] + eps;
   if (box.hi[2] <= depth_limit) return false;  // nothing of it more than eps in front
-  const double across = std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1],
-                                  box.hi[2] - box.lo[2]});
+  const double across =
+      std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
   const bool small = across <= leaf || level >= kMaxLevels;
   if (box.lo[2] > depth_limit || small) {
     const double mid = piece.size / 2;

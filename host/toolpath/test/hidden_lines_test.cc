@@ -69,13 +69,14 @@ class MeshReference {
         points.push_back(map.Apply(EvaluateReference(patch, double(i) / grid, double(j) / grid)));
       }
     }
-    const auto at = [&](int i, int j) { return points[static_cast<std::size_t>(i * (grid + 1) + j)]; };
+    const auto at = [&](int i, int j) {
+      return points[static_cast<std::size_t>(i * (grid + 1) + j)];
+    };
     for (int i = 0; i < grid; ++i) {
       for (int j = 0; j < grid; ++j) {
         triangles_.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
         triangles_.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-        const Vec exact =
-            map.Apply(EvaluateReference(patch, (i + 0.5) / grid, (j + 0.5) / grid));
+        const Vec exact = map.Apply(EvaluateReference(patch, (i + 0.5) / grid, (j + 0.5) / grid));
         const Vec a = at(i, j);
         const Vec c = at(i + 1, j + 1);
         const Vec mid{(a[0] + c[0]) / 2, (a[1] + c[1]) / 2, (a[2] + c[2]) / 2};
@@ -120,7 +121,8 @@ class MeshReference {
                                                      Clamp((x - lo_[0]) / cell_))];
     for (const std::size_t k : bin) {
       const Triangle& t = triangles_[k];
-      const double d = (t.b[0] - t.a[0]) * (t.c[1] - t.a[1]) - (t.c[0] - t.a[0]) * (t.b[1] - t.a[1]);
+      const double d =
+          (t.b[0] - t.a[0]) * (t.c[1] - t.a[1]) - (t.c[0] - t.a[0]) * (t.b[1] - t.a[1]);
       if (std::fabs(d) < 1e-18) continue;  // seen edge-on: covers no area
       const double u = ((x - t.a[0]) * (t.c[1] - t.a[1]) - (t.c[0] - t.a[0]) * (y - t.a[1])) / d;
       const double v = ((t.b[0] - t.a[0]) * (y - t.a[1]) - (x - t.a[0]) * (t.b[1] - t.a[1])) / d;
@@ -153,8 +155,9 @@ ToolpathOptions Options(const std::string& view, double tolerance) {
 // The exact point of a stroke with its depth (ExactStrokePoint drops it in 2-D).
 Vec ExactWithDepth(const PatchSet& set, const Toolpath& path, const Stroke& s, double u) {
   const Patch& patch = set.patches[s.patch];
-  return path.map.Apply(s.family == IsolineFamily::kSLines ? EvaluateReference(patch, s.line_param, u)
-                                                           : EvaluateReference(patch, u, s.line_param));
+  return path.map.Apply(s.family == IsolineFamily::kSLines
+                            ? EvaluateReference(patch, s.line_param, u)
+                            : EvaluateReference(patch, u, s.line_param));
 }
 
 bool SameLine(const Stroke& a, const Stroke& b) {
@@ -210,9 +213,8 @@ std::size_t CheckAgainstReference(const PatchSet& set, const Drawn& d, const Mes
         const double a = std::min(piece.params.front(), piece.params.back());
         const double b = std::max(piece.params.front(), piece.params.back());
         if (u < a || u > b) continue;
-        const double to_end =
-            std::min(PlaneDistance(p, ExactWithDepth(set, d.after, piece, a)),
-                     PlaneDistance(p, ExactWithDepth(set, d.after, piece, b)));
+        const double to_end = std::min(PlaneDistance(p, ExactWithDepth(set, d.after, piece, a)),
+                                       PlaneDistance(p, ExactWithDepth(set, d.after, piece, b)));
         if (to_end > d.options.locate + mesh.margin()) ++hidden_drawn;
       }
     }
@@ -407,8 +409,9 @@ TEST(HiddenLines, APatchSeenEdgeOnHidesOnlyAlongItsLine) {
   double back_before = 0;
   double back_after = 0;
   for (const Stroke& s : d.before.strokes) {
-    if (s.patch == 1) back_before += PlaneDistance(ExactWithDepth(set, d.before, s, 0),
-                                                   ExactWithDepth(set, d.before, s, 1));
+    if (s.patch == 1)
+      back_before +=
+          PlaneDistance(ExactWithDepth(set, d.before, s, 0), ExactWithDepth(set, d.before, s, 1));
   }
   bool nearest_edge_whole = false;
   for (const Stroke& s : d.after.strokes) {
