@@ -43,6 +43,8 @@ struct PlotOptions {
   int dims = 2;
   bool plan = true;
   bool quiet = false;
+  /// --hidden: "show" (every line) or "remove" (hidden_lines.h).
+  std::string hidden = "show";
   GcodeOptions gcode;
 };
 

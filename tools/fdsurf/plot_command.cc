@@ -8,6 +8,7 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/plan.h"
 #include "fdsurf/host/text.h"
@@ -149,6 +150,23 @@ void AddGcodeFlavorOptions(CLI::App* command, GcodeOptions* g) {
       ->capture_default_str();
 }
 
+// --hidden remove: only the visible pieces of the lines, with the tolerances
+// stated on stderr.
+void RemoveHidden(const PlotOptions& o, const PatchSet& set, const ToolpathOptions& t,
+                  const std::string& work_units, Toolpath* path) {
+  const HiddenLineOptions hidden = HiddenLineDefaults(t.tolerance);
+  const HiddenLineReport r = RemoveHiddenLines(set, hidden, path);
+  if (o.quiet) return;
+  const char* u = work_units.c_str();
+  std::fprintf(stderr,
+               "hidden: %zu strokes -> %zu visible pieces; drawn %.1f -> %.1f %s; %zu points "
+               "tested in %.2f s (depth margin %s %s, cuts located within %s %s, samples at "
+               "most %s %s apart)\n",
+               r.strokes_before, r.strokes_after, r.length_before, r.length_after, u, r.queries,
+               r.seconds, FormatNumber(hidden.eps).c_str(), u, FormatNumber(hidden.locate).c_str(),
+               u, FormatNumber(hidden.spacing).c_str(), u);
+}
+
 }  // namespace
 
 int RunPlot(const PlotOptions& o, bool render_only) {
@@ -169,6 +187,7 @@ int RunPlot(const PlotOptions& o, bool render_only) {
         }
       });
   if (progress) std::fputc('\n', stderr);
+  if (o.hidden == "remove") RemoveHidden(o, set, t, work_units, &path);
   const DrawnCounts counts = CountDrawn(path);
   PlanReport plan;
   if (o.plan) plan = PlanStrokes(set, &path);
@@ -265,6 +284,12 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
     command->add_flag("!--no-plan", o->plan,
                       "keep the curves as drawn, without joining or ordering");
   }
+  command
+      ->add_option("--hidden", o->hidden,
+                   "show (every line) or remove (only what is visible from the view, against "
+                   "the exact patches)")
+      ->check(CLI::IsMember({"show", "remove"}))
+      ->capture_default_str();
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 

@@ -135,10 +135,18 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--size", o->png_width, "PNG width in pixels")
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
+  command->add_option("--hidden", o->hidden, "show (remove: plot and render only)")
+      ->check(CLI::IsMember({"show", "remove"}));
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 
 int RunStream(const StreamOptions& o) {
+  if (o.hidden == "remove") {
+    throw InputError(
+        "--hidden remove: the device evaluates whole isolines itself, so stream cannot leave "
+        "their hidden parts out; draw the visible lines with `fdsurf plot --hidden remove` "
+        "(G-code, HPGL) instead");
+  }
   const bool sim = o.device == "sim";
   const bool usb = o.device == "usb" || o.device.rfind("usb:", 0) == 0;
   const bool gpio = o.device.rfind("gpio:", 0) == 0;

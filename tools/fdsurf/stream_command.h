@@ -47,6 +47,8 @@ struct StreamOptions {
   std::string waveform;
   int png_width = 1600;
   bool quiet = false;
+  /// --hidden: only "show"; "remove" is refused (the device draws whole isolines).
+  std::string hidden = "show";
 };
 
 /// Adds the options of `stream` to `command`.

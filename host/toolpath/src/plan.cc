@@ -103,6 +103,17 @@ void Append(Stroke* chain, const Stroke& other) {
 // The exact curve a stroke of BuildToolpath draws.
 SampledCurve SampleStroke(const PatchSet& set, const Toolpath& path, const Stroke& stroke) {
   const double unit = path.quantum.value();
+  // A piece of a line (hidden-line removal cuts lines) is sampled over its
+  // own parameters, so that two pieces of one line are not one curve.
+  const double from = stroke.params.empty() ? 0.0 : stroke.params.front();
+  const double to = stroke.params.empty() ? 1.0 : stroke.params.back();
+  if (std::min(from, to) > 0 || std::max(from, to) < 1) {
+    return Sample([&](double u) {
+      PlanPoint p = ExactStrokePoint(set, path, stroke, from + (to - from) * u);
+      for (double& c : p) c /= unit;
+      return p;
+    });
+  }
   if (stroke.curve >= 0) {
     return SampleCurve(set.curves[static_cast<std::size_t>(stroke.curve)], path.map, unit,
                        path.dims);
