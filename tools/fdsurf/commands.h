@@ -37,6 +37,7 @@ struct PlotOptions {
   std::string view = "iso";
   std::string units = "mm";
   std::string fit;
+  std::string origin;
   std::string margin;
   std::string quantum;
   std::string mode = "adaptive";

@@ -19,7 +19,9 @@ struct StreamOptions {
   std::string lines = "8";
   std::string view = "iso";
   std::string units = "mm";
-  std::string fit = "200x150";
+  /// --fit and --origin as typed, "" when left out (PlacePage's defaults).
+  std::string fit;
+  std::string origin;
   std::string margin;
   std::string tolerance;
   int dims = 2;
