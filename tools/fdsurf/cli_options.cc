@@ -44,12 +44,20 @@ Grid ParseGrid(const std::string& text) {
   return grid;
 }
 
-void AddGridOptions(CLI::App* command, GridOptions* options) {
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format) {
   command
-      ->add_option(
-          "FILE", options->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+      ->add_option("FILE", *file,
+                   "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); - reads "
+                   "standard input; see docs/formats.md")
       ->required();
+  command
+      ->add_option("--input-format", *input_format,
+                   "the drawing's format when neither its suffix nor its content tells")
+      ->check(CLI::IsMember({"bpt", "json", "obj", "ply", "svg", "gcode"}));
+}
+
+void AddGridOptions(CLI::App* command, GridOptions* options) {
+  AddInputOptions(command, &options->file, &options->input_format);
   command
       ->add_option("--grid", options->grid,
                    "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))

@@ -28,10 +28,16 @@ Grid ParseGrid(const std::string& text);
 /// The options of `sample` and `check`: a file evaluated on a grid.
 struct GridOptions {
   std::string file;
+  std::string input_format;
   std::string grid;
   std::string engine = "fixed";
   std::string quantum = "0.001";
 };
+
+/// Adds FILE (a path, or - for standard input) and --input-format (bpt,
+/// json, obj, ply, svg, gcode: for when neither the suffix nor the content
+/// tells), as every command that reads a drawing has them.
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format);
 
 /// Adds FILE, --grid and --quantum (the options `sample` and `check` share).
 void AddGridOptions(CLI::App* command, GridOptions* options);

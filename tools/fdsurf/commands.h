@@ -28,6 +28,7 @@ int RunCheck(const GridOptions& options);
 
 struct PlotOptions {
   std::string file;
+  std::string input_format;
   std::string format;
   std::string output = "-";
   std::string png;

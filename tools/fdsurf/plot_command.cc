@@ -184,11 +184,14 @@ void PrintSummary(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
 
 }  // namespace
 
-int RunPlot(const PlotOptions& o, bool render_only) {
+int RunPlot(const PlotOptions& typed, bool render_only) {
+  // Messages name standard input "<stdin>", as the reader does.
+  PlotOptions o = typed;
+  if (o.file == "-") o.file = "<stdin>";
   const std::string format = OutputFormat(o, render_only);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadPatchFile(typed.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
   PlacePage(o.fit, o.origin, o.units, ToWork(o, format), set, &t);
@@ -230,11 +233,7 @@ int RunPlot(const PlotOptions& o, bool render_only) {
 }
 
 void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
-  command
-      ->add_option(
-          "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
-      ->required();
+  AddInputOptions(command, &o->file, &o->input_format);
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();
   } else {

@@ -80,11 +80,7 @@ void RefuseOutsideTravel(const Toolpath& page, const MachineOptions& machine, Pa
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
-  command
-      ->add_option(
-          "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
-      ->required();
+  AddInputOptions(command, &o->file, &o->input_format);
   command
       ->add_option("--device", o->device,
                    "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
@@ -157,7 +153,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 
-int RunStream(const StreamOptions& o) {
+int RunStream(const StreamOptions& typed) {
+  // Messages name standard input "<stdin>", as the reader does.
+  StreamOptions o = typed;
+  if (o.file == "-") o.file = "<stdin>";
   const bool sim = o.device == "sim";
   const bool usb = o.device == "usb" || o.device.rfind("usb:", 0) == 0;
   const bool gpio = o.device.rfind("gpio:", 0) == 0;
@@ -176,7 +175,7 @@ int RunStream(const StreamOptions& o) {
   }
   const ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadPatchFile(typed.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);

@@ -14,6 +14,7 @@ namespace fdsurf::host {
 
 struct StreamOptions {
   std::string file;
+  std::string input_format;
   std::string device = "sim";
   // The drawing, as for `fdsurf plot`.
   std::string lines = "8";
