@@ -146,7 +146,19 @@ std::optional<std::array<double, 2>> ParsePage(const std::string& text, const st
     return page;
   }
   const std::size_t x = text.find('x');
-  if (landscape || x == std::string::npos) {
+  // Both sides must read as numbers for a WxH; ParsePositive then says which
+  // one is out of range.
+  const auto is_number = [](const std::string& part) {
+    std::size_t used = 0;
+    try {
+      (void)std::stod(part, &used);
+    } catch (const std::exception&) {
+      return false;
+    }
+    return used == part.size();
+  };
+  if (landscape || x == std::string::npos || !is_number(text.substr(0, x)) ||
+      !is_number(text.substr(x + 1))) {
     throw InputError(what + ": '" + text +
                      "' is not WxH (like 200x150) or a paper name (A3, A4, A5, letter, legal, "
                      "optionally :landscape)");
