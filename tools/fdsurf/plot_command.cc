@@ -52,7 +52,7 @@ std::string OutputFormat(const PlotOptions& o, bool render_only) {
     return "png";
   }
   if (o.output == "-") return o.format.empty() ? "svg" : o.format;
-  const std::string by_suffix = FormatFromSuffix(o.output);
+  std::string by_suffix = FormatFromSuffix(o.output);
   if (by_suffix.empty()) {
     throw InputError("-o: '" + o.output +
                      "' has no suffix of a format fdsurf writes (.svg, .gcode, .nc, .ngc, "
@@ -184,14 +184,14 @@ void PrintSummary(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
 
 }  // namespace
 
-int RunPlot(const PlotOptions& typed, bool render_only) {
+int RunPlot(const PlotOptions& options, bool render_only) {
   // Messages name standard input "<stdin>", as the reader does.
-  PlotOptions o = typed;
+  PlotOptions o = options;
   if (o.file == "-") o.file = "<stdin>";
   const std::string format = OutputFormat(o, render_only);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadPatchFile(typed.file, o.input_format);
+  const PatchSet set = ReadPatchFile(options.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
   PlacePage(o.fit, o.origin, o.units, ToWork(o, format), set, &t);

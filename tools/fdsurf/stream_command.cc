@@ -153,9 +153,9 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 
-int RunStream(const StreamOptions& typed) {
+int RunStream(const StreamOptions& options) {
   // Messages name standard input "<stdin>", as the reader does.
-  StreamOptions o = typed;
+  StreamOptions o = options;
   if (o.file == "-") o.file = "<stdin>";
   const bool sim = o.device == "sim";
   const bool usb = o.device == "usb" || o.device.rfind("usb:", 0) == 0;
@@ -175,7 +175,7 @@ int RunStream(const StreamOptions& typed) {
   }
   const ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadPatchFile(typed.file, o.input_format);
+  const PatchSet set = ReadPatchFile(options.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
