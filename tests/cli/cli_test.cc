@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -27,6 +28,16 @@ using fdsurf::test_support::Slurp;
 class Cli : public fdsurf::test_support::ToolTest {
  protected:
   Cli() : ToolTest("fdsurf_cli_") {}
+
+  // Runs `fdsurf ARGS` with standard input read from `input` (a file).
+  RunResult RunWithInput(const std::string& args, const std::string& input) {
+    const fs::path out = dir_ / "stdout";
+    const fs::path err = dir_ / "stderr";
+    const std::string command = std::string("timeout 120 '") + FDSURF_BINARY + "' " + args + " >'" +
+                                out.string() + "' 2>'" + err.string() + "' <'" + input + "'";
+    const int status = std::system(command.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, Slurp(out), Slurp(err)};
+  }
 
   // Asserts the contract for bad input.
   void ExpectRefused(const std::string& args, const std::string& stderr_part) {
@@ -197,9 +208,11 @@ TEST_F(Cli, PlotRefusesBadOptionsAndLeavesNoFile) {
   refused("--lines 1", "--lines: '1' is not U or UxV");
   refused("--lines 0x0", "both families are left out");
   refused("--fit 20x10 --margin 10", "--fit: the page 20x10 leaves no room");
-  refused("--fit 20", "--fit: '20' is not WxH");
   refused("--dims 3", "--dims 3: only G-code and JSON carry a third axis");
-  refused("--format hpgl --quantum 0.01", "HPGL positions are plotter units");
+  refused("--fit 20", "--fit: '20' is not WxH (like 200x150) or a paper name");
+  ExpectRefused("plot '" + kTeapot + "' -o '" + (dir_ / "out.hpgl").string() + "' --quantum 0.01",
+                "HPGL positions are plotter units");
+  EXPECT_FALSE(fs::exists(dir_ / "out.hpgl"));
   ExpectRefused("plot '" + kTeapot + "' -o '" + (dir_ / "missing" / "out.svg").string() + "'",
                 "missing/out.svg.fdsurf-");
   ExpectRefused(
@@ -318,6 +331,259 @@ TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   EXPECT_NE(gpio.err.find("gpiochip99"), std::string::npos) << gpio.err;
   // A tolerance that whole steps cannot keep is refused before anything moves.
   EXPECT_EQ(Run("stream '" + kTeapot + "' --step 0.1 --tolerance 0.05").exit_code, 2);
+}
+
+// A JSON curve from (10, 10) to (40, 30) in mm, monotone in x and y: its
+// extent is its end points, so every placement can be worked out by hand.
+const char* const kCurveJson = R"({"units": "mm", "curves": [{"type": "cubic", "basis": "bezier",
+  "points": [[10, 10, 0], [20, 10, 0], [30, 20, 0], [40, 30, 0]]}]})";
+
+// The page of an SVG written by fdsurf: its width and height attributes (mm or in).
+std::array<double, 2> SvgPage(const std::string& svg) {
+  const auto attribute = [&](const std::string& name) {
+    const std::size_t at = svg.find(" " + name + "=\"");
+    if (at == std::string::npos) return -1.0;
+    return std::stod(svg.substr(at + name.size() + 3));
+  };
+  return {attribute("width"), attribute("height")};
+}
+
+// The first position a G-code program moves to: "G0 X.. Y.." as text.
+std::string FirstMove(const std::string& gcode) {
+  const std::size_t at = gcode.find("\nG0 X");
+  if (at == std::string::npos) return "";
+  return gcode.substr(at + 4, gcode.find('\n', at + 1) - at - 4);
+}
+
+TEST_F(Cli, FitTakesPaperNamesPortraitOrLandscapeInEitherUnit) {
+  const std::string out = (dir_ / "page.svg").string();
+  // ISO 216 (mm) and the US sizes (8.5 x 11 and 8.5 x 14 inches), portrait.
+  struct Paper {
+    const char* name;
+    double width_mm;
+    double height_mm;
+  };
+  const Paper papers[] = {{"A3", 297, 420},
+                          {"A4", 210, 297},
+                          {"A5", 148, 210},
+                          {"letter", 215.9, 279.4},
+                          {"legal", 215.9, 355.6}};
+  for (const Paper& paper : papers) {
+    for (const bool landscape : {false, true}) {
+      for (const std::string units : {"mm", "in"}) {
+        const std::string fit = std::string(paper.name) + (landscape ? ":landscape" : "");
+        const RunResult r = Run("plot '" + kTeapot + "' --lines 2 -q --units " + units + " --fit " +
+                                fit + " -o '" + out + "'");
+        ASSERT_EQ(r.exit_code, 0) << fit << r.err;
+        const double per_unit = units == "in" ? 25.4 : 1.0;
+        const double w = (landscape ? paper.height_mm : paper.width_mm) / per_unit;
+        const double h = (landscape ? paper.width_mm : paper.height_mm) / per_unit;
+        const auto page = SvgPage(Slurp(out));
+        // The writer prints the page in whole quanta (0.001 mm, 0.0001 in).
+        EXPECT_NEAR(page[0], w, units == "in" ? 1e-4 : 1e-3) << fit << " " << units;
+        EXPECT_NEAR(page[1], h, units == "in" ? 1e-4 : 1e-3) << fit << " " << units;
+      }
+    }
+  }
+  EXPECT_EQ(SvgPage(Slurp(out))[0] > 0, true);
+  for (const char* bad : {"A7", "A4:sideways", "200x150:landscape", "letterx", "x", ":landscape"}) {
+    ExpectRefused(
+        "plot '" + kTeapot + "' --fit '" + bad + "' -o '" + (dir_ / "bad.svg").string() + "'",
+        std::string("--fit: '") + bad +
+            "' is not WxH (like 200x150) or a paper name (A3, A4, A5, letter, legal, "
+            "optionally :landscape)");
+    EXPECT_FALSE(fs::exists(dir_ / "bad.svg")) << bad;
+  }
+  ExpectRefused("stream '" + kTeapot + "' --fit A7", "--fit: 'A7' is not WxH");
+}
+
+TEST_F(Cli, OriginKeepWritesTheFilesCoordinates) {
+  const std::string file = Write("curve.json", kCurveJson);
+  const RunResult keep = Run("plot '" + file + "' --view top --origin keep --format gcode -q");
+  ASSERT_EQ(keep.exit_code, 0) << keep.err;
+  EXPECT_EQ(FirstMove(keep.out), "X10.000 Y10.000");
+  EXPECT_NE(keep.out.find("\nG1 X40.000 Y30.000"), std::string::npos) << keep.out;
+  // min without a page: the lower-left corner (10, 10) at the 5 mm margin.
+  const RunResult min =
+      Run("plot '" + file + "' --view top --origin min --fit none --format gcode -q");
+  ASSERT_EQ(min.exit_code, 0) << min.err;
+  EXPECT_EQ(FirstMove(min.out), "X5.000 Y5.000");
+  // center on 100 x 100 with no margin: scale 100/30, the 66.667-high
+  // drawing centred, so (10, 10) goes to (0, 16.667).
+  const RunResult center = Run("plot '" + file +
+                               "' --view top --origin center --fit 100x100 --margin 0 "
+                               "--format gcode -q");
+  ASSERT_EQ(center.exit_code, 0) << center.err;
+  EXPECT_EQ(FirstMove(center.out), "X0.000 Y16.667");
+  // keep with a page the drawing lies in: that page, unscaled.
+  const std::string svg = (dir_ / "keep.svg").string();
+  const RunResult paged =
+      Run("plot '" + file + "' --view top --origin keep --fit 50x40 -q -o '" + svg + "'");
+  ASSERT_EQ(paged.exit_code, 0) << paged.err;
+  EXPECT_EQ(SvgPage(Slurp(svg)), (std::array<double, 2>{50, 40}));
+  EXPECT_NE(Slurp(svg).find("M10.000 30.000"), std::string::npos);  // y down: 40 - 10
+  // keep with a page it does not fit: refused, no file.
+  const std::string small = (dir_ / "small.svg").string();
+  ExpectRefused("plot '" + file + "' --view top --origin keep --fit 30x30 -o '" + small + "'",
+                "--fit 30x30 is a page the drawing does not lie inside as it is (x 10..40, y "
+                "10..30)");
+  EXPECT_FALSE(fs::exists(small));
+  ExpectRefused("plot '" + file + "' --origin middle",
+                "--origin: 'middle' is not keep, center or min");
+}
+
+// A drawing below 0 under keep: G-code carries it as it is; an SVG page
+// (from 0) would cut it, and a machine's travel starts at 0: both refused.
+TEST_F(Cli, OriginKeepBelowZeroIsWrittenToGcodeAndRefusedForSvgAndStream) {
+  std::string text = kCurveJson;
+  text.replace(text.find("[10, 10, 0]"), 11, "[-10, 10, 0]");
+  const std::string file = Write("negative.json", text);
+  const RunResult gcode = Run("plot '" + file + "' --view top --origin keep --format gcode -q");
+  ASSERT_EQ(gcode.exit_code, 0) << gcode.err;
+  EXPECT_EQ(FirstMove(gcode.out), "X-10.000 Y10.000");
+  const std::string svg = (dir_ / "negative.svg").string();
+  ExpectRefused("plot '" + file + "' --view top --origin keep -o '" + svg + "'",
+                "--origin keep: the drawing runs over x -10..40, y 10..30 mm, below the SVG/PNG "
+                "page's 0");
+  EXPECT_FALSE(fs::exists(svg));
+  ExpectRefused("stream '" + file + "' --view top --origin keep",
+                "--origin keep: the drawing runs over x -10..40, y 10..30 mm, outside the "
+                "machine's travel x 0..45, y 0..35");
+}
+
+// One rule for both commands: the teapot (no page of its own) is centred on
+// 200 x 150 mm by plot and by stream alike, so plot's page and drawing are
+// the ones the simulated plotter draws.
+TEST_F(Cli, PlotAndStreamPlaceTheSameFileOnTheSamePage) {
+  const std::string plotted = (dir_ / "plot.svg").string();
+  const std::string drawn = (dir_ / "drawn.svg").string();
+  const RunResult plot = Run("plot '" + kTeapot + "' --lines 2 -q -o '" + plotted + "'");
+  ASSERT_EQ(plot.exit_code, 0) << plot.err;
+  const RunResult stream =
+      Run("stream '" + kTeapot + "' --lines 2 -q --speed 400 --accel 10000 --pen-delay 5 --svg '" +
+          drawn + "'");
+  ASSERT_EQ(stream.exit_code, 0) << stream.err;
+  const std::string a = Slurp(plotted);
+  const std::string b = Slurp(drawn);
+  EXPECT_EQ(SvgPage(a), (std::array<double, 2>{200, 150}));
+  EXPECT_EQ(SvgPage(b), SvgPage(a));
+  // The same map: the extent of every coordinate in the paths agrees within
+  // the two tolerances (0.05 mm each) and a step.
+  const auto extent = [](const std::string& svg) {
+    std::array<double, 4> box{HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (std::size_t at = svg.find(" d=\""); at != std::string::npos;
+         at = svg.find(" d=\"", at + 1)) {
+      std::istringstream path(svg.substr(at + 4, svg.find('"', at + 4) - at - 4));
+      std::string token;
+      while (path >> token) {
+        const double x = std::stod(token.substr(token[0] == 'M' || token[0] == 'L' ? 1 : 0));
+        path >> token;
+        const double y = std::stod(token);
+        box = {std::min(box[0], x), std::min(box[1], y), std::max(box[2], x), std::max(box[3], y)};
+      }
+    }
+    return box;
+  };
+  const auto pa = extent(a);
+  const auto pb = extent(b);
+  EXPECT_GT(pa[2] - pa[0], 100);  // fitted, not the teapot's few file units
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(pa[k], pb[k], 0.1 + 0.0125) << k;
+}
+
+TEST_F(Cli, DashReadsStandardInputForEveryCommand) {
+  const std::string json = Write("curve.json", kCurveJson);
+  // sample and check print the same as for the file (names aside).
+  for (const std::string command : {"sample", "check"}) {
+    const RunResult by_name = Run(command + " '" + kTeapot + "' --grid 2");
+    const RunResult piped = RunWithInput(command + " - --grid 2", kTeapot);
+    ASSERT_EQ(piped.exit_code, 0) << command << piped.err;
+    EXPECT_EQ(piped.out, by_name.out) << command;
+  }
+  // plot: the same strokes, JSON carries no file name.
+  const RunResult by_name = Run("plot '" + json + "' --format json -q");
+  const RunResult piped = RunWithInput("plot - --format json -q", json);
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_EQ(piped.out, by_name.out);
+  const std::string png = (dir_ / "in.png").string();
+  const RunResult render = RunWithInput("render - -q -o '" + png + "' --size 100", kTeapot);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_EQ(Slurp(png).substr(1, 3), "PNG");
+  const RunResult stream =
+      RunWithInput("stream - --view top --speed 400 --accel 10000 --pen-delay 5", json);
+  ASSERT_EQ(stream.exit_code, 0) << stream.err;
+  EXPECT_NE(stream.err.find("<stdin>: 0 patches and 1 curves streamed"), std::string::npos)
+      << stream.err;
+  // The format from the content, or --input-format; errors name <stdin>.
+  const std::string empty = Write("empty", "  \n");
+  const RunResult nothing = RunWithInput("plot -", empty);
+  EXPECT_EQ(nothing.exit_code, 2);
+  EXPECT_NE(nothing.err.find("fdsurf: error: <stdin>: the input is empty"), std::string::npos)
+      << nothing.err;
+  const RunResult told = RunWithInput("check - --grid 2 --input-format bpt", json);
+  EXPECT_EQ(told.exit_code, 2);
+  EXPECT_NE(told.err.find("<stdin>:1: the number of patches"), std::string::npos) << told.err;
+  const std::string word = Write("word", "hello\n");
+  const RunResult unknown = RunWithInput("plot -", word);
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("<stdin>: cannot tell the format from the content; say it with "
+                             "--input-format"),
+            std::string::npos)
+      << unknown.err;
+  EXPECT_EQ(unknown.out, "");
+  // A file without a suffix is read by its content too.
+  const std::string bare = Write("bare", kCurveJson);
+  EXPECT_EQ(Run("plot '" + bare + "' --format json -q").out, by_name.out);
+}
+
+// Outputs whose suffix says another format, or none fdsurf writes, are
+// refused before anything is drawn, and nothing is left behind.
+TEST_F(Cli, OutputSuffixMustSayTheFormat) {
+  const auto refused = [&](const std::string& args, const std::string& file,
+                           const std::string& part) {
+    ExpectRefused(args, part);
+    EXPECT_FALSE(fs::exists(dir_ / file)) << args;
+  };
+  const std::string d = dir_.string() + "/";
+  refused("plot '" + kTeapot + "' -o '" + d + "x.pdf'", "x.pdf",
+          "x.pdf' has no suffix of a format fdsurf writes (.svg, .gcode, .nc, .ngc, .hpgl, .plt, "
+          ".json)");
+  refused("plot '" + kTeapot + "' -o '" + d + "x.svg' --format gcode", "x.svg",
+          "x.svg' says svg but --format is gcode");
+  refused("render '" + kTeapot + "' -o '" + d + "out.svg'", "out.svg",
+          "-o: '" + d + "out.svg' does not end in .png; the picture is PNG");
+  refused("plot '" + kTeapot + "' -o '" + d + "x.svg' --png '" + d + "x.jpg'", "x.jpg",
+          "--png: '" + d + "x.jpg' does not end in .png");
+  EXPECT_FALSE(fs::exists(dir_ / "x.svg"));
+  // Upper-case suffixes are the same formats; stdout is SVG unless told.
+  EXPECT_EQ(Run("plot '" + kTeapot + "' --lines 2 -q -o '" + d + "T.GCODE'").exit_code, 0);
+  EXPECT_EQ(Slurp(dir_ / "T.GCODE").substr(0, 1), ";");
+  EXPECT_NE(Run("plot '" + kTeapot + "' --lines 2 -q").out.find("<svg"), std::string::npos);
+}
+
+// CLI11's own errors read like the tool's others and exit 2; --help and
+// --version still print and exit 0.
+TEST_F(Cli, ArgumentErrorsHaveTheToolsPrefixAndExitTwo) {
+  const auto argument_error = [&](const std::string& args, const std::string& part) {
+    const RunResult r = Run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(r.out, "") << args;
+    EXPECT_EQ(r.err.rfind("fdsurf: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  };
+  argument_error("plot '" + kTeapot + "' --bogus", "--bogus (see fdsurf plot --help)");
+  argument_error("plot", "FILE is required");
+  argument_error("sample '" + kTeapot + "' --grid", "--grid");
+  argument_error("plot '" + kTeapot + "' --units cm", "--units: cm not in {mm,in}");
+  argument_error("stream '" + kTeapot + "' --faults 0.9", "--faults");
+  argument_error("plot '" + kTeapot + "' --input-format pdf", "--input-format");
+  const RunResult help = Run("plot --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--origin"), std::string::npos);
+  EXPECT_EQ(help.err, "");
+  EXPECT_EQ(Run("--help").exit_code, 0);
+  const RunResult version = Run("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.out.rfind("fdsurf ", 0), 0u) << version.out;
 }
 
 }  // namespace

@@ -171,14 +171,14 @@ TEST_F(MeshCli, PlotOfTheOctahedronSeenFromTheTopIsTheSpheresDisc) {
   EXPECT_EQ(construction, 0.01);
 
   const std::string svg = (dir_ / "octahedron.svg").string();
-  const RunResult plot = Run("plot '" + kOctahedron + "' -o '" + svg + "' --view top");
+  const RunResult plot = Run("plot '" + kOctahedron + "' -o '" + svg + "' --view top --fit none");
   ASSERT_EQ(plot.exit_code, 0) << plot.err;
   EXPECT_EQ(plot.out, "");
   EXPECT_NE(plot.err.find("0 patches, 816 curves"), std::string::npos) << plot.err;
   EXPECT_NE(plot.err.find("wrote " + svg + " (svg"), std::string::npos) << plot.err;
   const std::string text = Slurp(svg);
   ASSERT_NE(text.find("<svg"), std::string::npos) << text.substr(0, 200);
-  // No --fit: file units, 5 mm margins.
+  // --fit none: file units, 5 mm margins.
   const Drawing d = ParseSvg(text);
   EXPECT_NEAR(d.width, 2 * kRadius + 10, kPlotBound);
   EXPECT_NEAR(d.height, 2 * kRadius + 10, kPlotBound);
@@ -193,7 +193,7 @@ TEST_F(MeshCli, PlotOfAPerturbedOctahedronFailsTheExtentCheck) {
   obj.replace(at, 10, "\nv 55 0 0\n");
   const std::string file = Write("perturbed.obj", obj);
   const std::string svg = (dir_ / "perturbed.svg").string();
-  const RunResult plot = Run("plot '" + file + "' -o '" + svg + "' --view top");
+  const RunResult plot = Run("plot '" + file + "' -o '" + svg + "' --view top --fit none");
   ASSERT_EQ(plot.exit_code, 0) << plot.err;
   const TopView v = Measure(ParseSvg(Slurp(svg)));
   EXPECT_FALSE(ExtentIsDiameter(v, kRadius, kPlotBound)) << v.width << " x " << v.height;

@@ -16,7 +16,7 @@ patches (isolines at s, t = i/(n-1): the patch's rows combined by Bernstein
 weights, which makes each isoline a Bézier curve) or a JSON file's
 "hermite-chain" curves (Bézier points P0, P0 + T0/3, P1 - T1/3, P1). They are
 placed on the page by the map docs/toolpaths.md states (view top/front/side,
-the exact bounding box, scale to --fit, centred; without --fit scale 1 and the
+the exact bounding box, scale to --fit, centred; with --fit none scale 1 and the
 margin). Every G5 must lie within --tolerance of an exact curve, point for
 point at the same parameter (17 samples), and every exact curve that is not a
 single point must be drawn by some G5.
@@ -185,7 +185,7 @@ def main():
         curves = read_bpt(args.input, int(args.lines))
     else:
         curves = read_hermite_chains(args.input)
-    fit = tuple(float(v) for v in args.fit.split("x")) if args.fit else None
+    fit = tuple(float(v) for v in args.fit.split("x")) if args.fit and args.fit != "none" else None
     exact = place(curves, args.view, fit, args.margin)
     tol = args.tolerance
 

@@ -6,12 +6,14 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/errors.h"
@@ -42,12 +44,20 @@ Grid ParseGrid(const std::string& text) {
   return grid;
 }
 
-void AddGridOptions(CLI::App* command, GridOptions* options) {
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format) {
   command
-      ->add_option(
-          "FILE", options->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+      ->add_option("FILE", *file,
+                   "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); - reads "
+                   "standard input; see docs/formats.md")
       ->required();
+  command
+      ->add_option("--input-format", *input_format,
+                   "the drawing's format when neither its suffix nor its content tells")
+      ->check(CLI::IsMember({"bpt", "json", "obj", "ply", "svg", "gcode"}));
+}
+
+void AddGridOptions(CLI::App* command, GridOptions* options) {
+  AddInputOptions(command, &options->file, &options->input_format);
   command
       ->add_option("--grid", options->grid,
                    "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))
@@ -94,13 +104,115 @@ std::array<int, 2> ParseLines(const std::string& text) {
   return {u, x == std::string::npos ? u : parse(all.substr(x + 1))};
 }
 
-std::array<double, 2> ParsePage(const std::string& text, const std::string& what) {
-  const std::size_t x = text.find('x');
-  if (x == std::string::npos) throw InputError(what + ": '" + text + "' is not WxH (like 200x150)");
-  return {ParsePositive(text.substr(0, x), what + " width"),
-          ParsePositive(text.substr(x + 1), what + " height")};
+namespace {
+
+struct Paper {
+  const char* name;
+  double width;
+  double height;
+  bool inches;
+};
+
+// ISO 216 (mm) and the US sizes (inches), portrait.
+constexpr Paper kPapers[] = {
+    {"a3", 297, 420, false},   {"a4", 210, 297, false},  {"a5", 148, 210, false},
+    {"letter", 8.5, 11, true}, {"legal", 8.5, 14, true},
+};
+
+std::string Lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
 }
 
+}  // namespace
+
+std::optional<std::array<double, 2>> ParsePage(const std::string& text, const std::string& units,
+                                               const std::string& what) {
+  if (text == "none") return std::nullopt;
+  std::string name = Lower(text);
+  bool landscape = false;
+  const std::string kLandscape = ":landscape";
+  if (name.size() > kLandscape.size() &&
+      name.compare(name.size() - kLandscape.size(), kLandscape.size(), kLandscape) == 0) {
+    landscape = true;
+    name.resize(name.size() - kLandscape.size());
+  }
+  for (const Paper& paper : kPapers) {
+    if (name != paper.name) continue;
+    const bool in = units == "in";
+    const double to_units = paper.inches == in ? 1.0 : (paper.inches ? 25.4 : 1 / 25.4);
+    std::array<double, 2> page{paper.width * to_units, paper.height * to_units};
+    if (landscape) std::swap(page[0], page[1]);
+    return page;
+  }
+  const std::size_t x = text.find('x');
+  // Both sides must read as numbers for a WxH; ParsePositive then says which
+  // one is out of range.
+  const auto is_number = [](const std::string& part) {
+    std::size_t used = 0;
+    try {
+      (void)std::stod(part, &used);
+    } catch (const std::exception&) {
+      return false;
+    }
+    return used == part.size();
+  };
+  if (landscape || x == std::string::npos || !is_number(text.substr(0, x)) ||
+      !is_number(text.substr(x + 1))) {
+    throw InputError(what + ": '" + text +
+                     "' is not WxH (like 200x150) or a paper name (A3, A4, A5, letter, legal, "
+                     "optionally :landscape)");
+  }
+  return std::array<double, 2>{ParsePositive(text.substr(0, x), what + " width"),
+                               ParsePositive(text.substr(x + 1), what + " height")};
+}
+
+void AddPageOptions(CLI::App* command, std::string* fit, std::string* origin, std::string* margin) {
+  command->add_option("--fit", *fit,
+                      "the page: WxH in --units, A3, A4, A5, letter or legal (:landscape for "
+                      "landscape), or none (no page: file units, no scaling); default: the "
+                      "file's own page, else 200x150 mm for a drawing that is fitted");
+  command->add_option("--origin", *origin,
+                      "keep (the file's coordinates are the machine's: not scaled or moved), "
+                      "center (scaled to fit, centred) or min (scaled to fit, lower-left corner "
+                      "at the margin); default: keep for a file with its own page or a G-code "
+                      "program, center otherwise");
+  command->add_option("--margin", *margin, "space around the drawing (default 5 mm / 0.2 in)");
+}
+
+PageOrigin ParseOrigin(const std::string& text) {
+  if (text == "keep") return PageOrigin::kKeep;
+  if (text == "center") return PageOrigin::kCenter;
+  if (text == "min") return PageOrigin::kMin;
+  throw InputError("--origin: '" + text + "' is not keep, center or min");
+}
+
+std::array<double, 2> DefaultPage(const std::string& units) {
+  return units == "in" ? std::array<double, 2>{200 / 25.4, 150 / 25.4}
+                       : std::array<double, 2>{200, 150};
+}
+
+void PlacePage(const std::string& fit, const std::string& origin, const std::string& units,
+               double to_work, const PatchSet& set, ToolpathOptions* t) {
+  const bool placed_by_author = set.page.has_value() || set.keep_order;
+  t->origin = origin.empty() ? (placed_by_author ? PageOrigin::kKeep : PageOrigin::kCenter)
+                             : ParseOrigin(origin);
+  t->fit.reset();
+  if (!fit.empty()) {
+    if (const auto page = ParsePage(fit, units)) {
+      t->fit = std::array<double, 2>{(*page)[0] * to_work, (*page)[1] * to_work};
+    }
+  } else if (set.page && t->origin != PageOrigin::kKeep) {
+    // The file's own page, in working units (PlanPage takes it itself under keep).
+    t->fit =
+        std::array<double, 2>{(*set.page)[0] * t->units_scale, (*set.page)[1] * t->units_scale};
+  } else if (t->origin != PageOrigin::kKeep) {
+    // A drawing that is moved anyway is fitted to the common page; one that
+    // keeps its coordinates keeps its size.
+    const auto page = DefaultPage(units);
+    t->fit = std::array<double, 2>{page[0] * to_work, page[1] * to_work};
+  }
+}
 View ParseView(const std::string& text) {
   if (const std::optional<View> named = NamedView(text)) return *named;
   const std::size_t comma = text.find(',');

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,10 +28,16 @@ Grid ParseGrid(const std::string& text);
 /// The options of `sample` and `check`: a file evaluated on a grid.
 struct GridOptions {
   std::string file;
+  std::string input_format;
   std::string grid;
   std::string engine = "fixed";
   std::string quantum = "0.001";
 };
+
+/// Adds FILE (a path, or - for standard input) and --input-format (bpt,
+/// json, obj, ply, svg, gcode: for when neither the suffix nor the content
+/// tells), as every command that reads a drawing has them.
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format);
 
 /// Adds FILE, --grid and --quantum (the options `sample` and `check` share).
 void AddGridOptions(CLI::App* command, GridOptions* options);
@@ -41,8 +48,35 @@ double ParsePositive(const std::string& text, const std::string& what, bool allo
 /// --lines: "U" or "UxV", each 0 (family left out) or 2..kMaxPatchSteps + 1.
 std::array<int, 2> ParseLines(const std::string& text);
 
-/// "WxH" with both > 0; `what` names the option in errors.
-std::array<double, 2> ParsePage(const std::string& text, const std::string& what = "--fit");
+/// A page for --fit: "WxH" with both > 0 (in `units`), or a paper name, A3,
+/// A4, A5 (ISO 216), letter or legal (US), in any case and optionally with
+/// ":landscape", portrait by default, converted to `units` ("mm" or "in").
+/// nullopt for "none" (no page: file units, no scaling). InputError naming
+/// `what` otherwise.
+std::optional<std::array<double, 2>> ParsePage(const std::string& text, const std::string& units,
+                                               const std::string& what = "--fit");
+
+/// Adds --fit, --origin and --margin with the one help text `plot`, `render`
+/// and `stream` share (the values are parsed by PlacePage).
+void AddPageOptions(CLI::App* command, std::string* fit, std::string* origin, std::string* margin);
+
+/// --origin: "keep", "center" or "min"; InputError otherwise.
+PageOrigin ParseOrigin(const std::string& text);
+
+/// The page when --fit is left out for a drawing that is fitted: 200 x 150 mm
+/// (in inches for units "in").
+std::array<double, 2> DefaultPage(const std::string& units);
+
+/// --fit and --origin as typed ("" when left out), one rule for `plot`,
+/// `render` and `stream` (docs/toolpaths.md, "The page"): a file with its own
+/// page (PatchSet::page) or a program (PatchSet::keep_order) keeps its
+/// coordinates (origin keep, on its page or --fit's); any other drawing is
+/// centred and scaled to fit --fit, by default its own page or else
+/// 200 x 150 mm. `to_work` converts --units to the job's working units (HPGL
+/// works in mm); t->units_scale must already be set (file to working units).
+/// Sets t->fit and t->origin; InputError for a bad --fit or --origin.
+void PlacePage(const std::string& fit, const std::string& origin, const std::string& units,
+               double to_work, const PatchSet& set, ToolpathOptions* t);
 
 /// --view: "top", "front", "side", "iso" or "AZ,EL" in degrees (azimuth
 /// from +x towards +y of the eye's direction, elevation above the xy plane).

@@ -28,6 +28,7 @@ int RunCheck(const GridOptions& options);
 
 struct PlotOptions {
   std::string file;
+  std::string input_format;
   std::string format;
   std::string output = "-";
   std::string png;
@@ -37,6 +38,7 @@ struct PlotOptions {
   std::string view = "iso";
   std::string units = "mm";
   std::string fit;
+  std::string origin;
   std::string margin;
   std::string quantum;
   std::string mode = "adaptive";

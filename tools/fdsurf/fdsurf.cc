@@ -124,7 +124,15 @@ int Main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version are "errors" with exit code 0: CLI11 prints them.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    // Everything else is bad arguments: the tool's own prefix and code 2,
+    // like every other refusal.
+    const std::string help = argc >= 2 && argv[1][0] != '-'
+                                 ? std::string("fdsurf ") + argv[1] + " --help"
+                                 : std::string("fdsurf --help");
+    std::fprintf(stderr, "fdsurf: error: %s (see %s)\n", e.what(), help.c_str());
+    return 2;
   }
   return RunParsed(commands);
 }

@@ -2,6 +2,7 @@
 // `fdsurf plot` and `fdsurf render`: the patches' isolines as SVG, G-code,
 // HPGL, JSON strokes or a PNG picture.
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -18,15 +19,72 @@
 namespace fdsurf::host {
 namespace {
 
-std::string FormatFromName(const std::string& name) {
-  const auto ends_with = [&](const char* ext) {
-    const std::string e(ext);
-    return name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0;
+std::string LowerSuffix(const std::string& name) {
+  const std::size_t slash = name.find_last_of('/');
+  const std::size_t dot = name.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string suffix = name.substr(dot);
+  for (char& c : suffix) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return suffix;
+}
+
+// The format an output's suffix says, "" for a suffix no format has.
+std::string FormatFromSuffix(const std::string& name) {
+  const std::string suffix = LowerSuffix(name);
+  if (suffix == ".svg") return "svg";
+  if (suffix == ".gcode" || suffix == ".nc" || suffix == ".ngc") return "gcode";
+  if (suffix == ".hpgl" || suffix == ".plt") return "hpgl";
+  if (suffix == ".json") return "json";
+  return "";
+}
+
+// The output format: --format, or -o's suffix, or SVG for stdout. A file
+// whose suffix says another format, or no known one, is refused before
+// anything is drawn: `-o x.pdf` would otherwise be an SVG named .pdf.
+std::string OutputFormat(const PlotOptions& o, bool render_only) {
+  const auto require_png = [](const std::string& file, const std::string& flag) {
+    if (LowerSuffix(file) != ".png") {
+      throw InputError(flag + ": '" + file + "' does not end in .png; the picture is PNG");
+    }
   };
-  if (ends_with(".gcode") || ends_with(".nc") || ends_with(".ngc")) return "gcode";
-  if (ends_with(".hpgl") || ends_with(".plt")) return "hpgl";
-  if (ends_with(".json")) return "json";
-  return "svg";
+  if (!o.png.empty()) require_png(o.png, "--png");
+  if (render_only) {
+    require_png(o.output, "-o");
+    return "png";
+  }
+  if (o.output == "-") return o.format.empty() ? "svg" : o.format;
+  std::string by_suffix = FormatFromSuffix(o.output);
+  if (by_suffix.empty()) {
+    throw InputError("-o: '" + o.output +
+                     "' has no suffix of a format fdsurf writes (.svg, .gcode, .nc, .ngc, "
+                     ".hpgl, .plt, .json)");
+  }
+  if (!o.format.empty() && o.format != by_suffix) {
+    throw InputError("-o: '" + o.output + "' says " + by_suffix + " but --format is " + o.format);
+  }
+  return by_suffix;
+}
+
+// Working units per --units unit (HPGL works in mm).
+double ToWork(const PlotOptions& o, const std::string& format) {
+  return format == "hpgl" && o.units == "in" ? 25.4 : 1.0;
+}
+
+// SVG and PNG pages start at 0: a drawing kept at its own coordinates that
+// reaches below 0 would be cut off, so it is refused (G-code, HPGL and JSON
+// carry negative coordinates as they are).
+void RefuseCutOff(const PlotOptions& o, const std::string& format, const ToolpathOptions& t,
+                  const Toolpath& path) {
+  const bool paged = format == "svg" || format == "png" || !o.png.empty();
+  if (!paged || t.origin != PageOrigin::kKeep) return;
+  const double slack = t.quantum.value() / 2;
+  if (path.drawing_lo[0] >= -slack && path.drawing_lo[1] >= -slack) return;
+  throw InputError("--origin keep: the drawing runs over x " + FormatNumber(path.drawing_lo[0]) +
+                   ".." + FormatNumber(path.drawing_hi[0]) + ", y " +
+                   FormatNumber(path.drawing_lo[1]) + ".." + FormatNumber(path.drawing_hi[1]) +
+                   " " + path.units +
+                   ", below the SVG/PNG page's 0; write G-code, HPGL or JSON, or use --origin "
+                   "min or center");
 }
 
 // The drawing options from the command line, in the job's working units
@@ -35,7 +93,7 @@ std::string FormatFromName(const std::string& name) {
 ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
                                std::string* work_units) {
   const bool hpgl = format == "hpgl";
-  const double to_work = hpgl && o.units == "in" ? 25.4 : 1.0;
+  const double to_work = ToWork(o, format);
   *work_units = hpgl ? "mm" : o.units;
   ToolpathOptions t;
   t.tolerance = to_work * (o.tolerance.empty() ? (o.units == "in" ? 0.002 : 0.05)
@@ -44,10 +102,9 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   t.lines_s = lines[0];
   t.lines_t = lines[1];
   t.view = ParseView(o.view);
-  if (!o.fit.empty()) {
-    auto page = ParsePage(o.fit);
-    t.fit = std::array<double, 2>{page[0] * to_work, page[1] * to_work};
-  }
+  // Checked before the file is read; PlacePage sets the page after.
+  if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
+  if (!o.origin.empty()) (void)ParseOrigin(o.origin);
   t.margin = to_work * (o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0)
                                          : ParsePositive(o.margin, "--margin", true));
   if (hpgl) {
@@ -169,14 +226,18 @@ void RemoveHidden(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
 
 }  // namespace
 
-int RunPlot(const PlotOptions& o, bool render_only) {
-  const std::string format =
-      render_only ? "png" : (o.format.empty() ? FormatFromName(o.output) : o.format);
+int RunPlot(const PlotOptions& options, bool render_only) {
+  // Messages name standard input "<stdin>", as the reader does.
+  PlotOptions o = options;
+  if (o.file == "-") o.file = "<stdin>";
+  const std::string format = OutputFormat(o, render_only);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadPatchFile(options.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
+  PlacePage(o.fit, o.origin, o.units, ToWork(o, format), set, &t);
+  RefuseCutOff(o, format, t, PlanPage(set, t, work_units));
 
   const bool progress = ShowProgress(o.quiet);
   Toolpath path =
@@ -215,11 +276,7 @@ int RunPlot(const PlotOptions& o, bool render_only) {
 }
 
 void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
-  command
-      ->add_option(
-          "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
-      ->required();
+  AddInputOptions(command, &o->file, &o->input_format);
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();
   } else {
@@ -246,8 +303,7 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
   command->add_option("--units", o->units, "units of the output and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
-  command->add_option("--fit", o->fit, "scale the drawing to fit a WxH page");
-  command->add_option("--margin", o->margin, "space around the drawing (default 5 mm / 0.2 in)");
+  AddPageOptions(command, &o->fit, &o->origin, &o->margin);
   command->add_option("--quantum", o->quantum,
                       "output resolution (default 0.001 mm / 0.0001 in; HPGL 0.025 mm)");
   command

@@ -8,6 +8,7 @@
 #include "cli_options.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
+#include "fdsurf/host/text.h"
 #include "runners/runner.h"
 #include "runners/serial_session.h"
 
@@ -22,10 +23,9 @@ ToolpathOptions DrawingOptions(const StreamOptions& o) {
   t.lines_s = lines[0];
   t.lines_t = lines[1];
   t.view = ParseView(o.view);
-  if (!o.fit.empty() && o.fit != "none") {
-    const auto page = ParsePage(o.fit);
-    t.fit = std::array<double, 2>{page[0], page[1]};
-  }
+  // Checked before the file is read; PlacePage sets the page after.
+  if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
+  if (!o.origin.empty()) (void)ParseOrigin(o.origin);
   t.margin =
       o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0) : ParsePositive(o.margin, "--margin", true);
   t.dims = o.dims;
@@ -56,14 +56,31 @@ MachineOptions Machine(const StreamOptions& o) {
   return m;
 }
 
+// A drawing kept at its own coordinates must lie inside the machine's
+// travel, which starts at 0: say so with the extent, before the device's
+// own check would name the first command that leaves it.
+void RefuseOutsideTravel(const Toolpath& page, const MachineOptions& machine, PageOrigin origin) {
+  if (origin != PageOrigin::kKeep) return;
+  const double slack = machine.step.value() / 2;
+  const std::array<double, 2> travel{machine.travel[0] > 0 ? machine.travel[0] : page.width,
+                                     machine.travel[1] > 0 ? machine.travel[1] : page.height};
+  bool inside = true;
+  for (int c = 0; c < 2; ++c) {
+    inside = inside && page.drawing_lo[c] >= -slack && page.drawing_hi[c] <= travel[c] + slack;
+  }
+  if (inside) return;
+  throw InputError("--origin keep: the drawing runs over x " + FormatNumber(page.drawing_lo[0]) +
+                   ".." + FormatNumber(page.drawing_hi[0]) + ", y " +
+                   FormatNumber(page.drawing_lo[1]) + ".." + FormatNumber(page.drawing_hi[1]) +
+                   " " + page.units + ", outside the machine's travel x 0.." +
+                   FormatNumber(travel[0]) + ", y 0.." + FormatNumber(travel[1]) +
+                   "; use --origin min or center to place it on the page");
+}
+
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
-  command
-      ->add_option(
-          "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
-      ->required();
+  AddInputOptions(command, &o->file, &o->input_format);
   command
       ->add_option("--device", o->device,
                    "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
@@ -78,9 +95,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--units", o->units, "units of the drawing and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
-  command->add_option("--fit", o->fit, "scale the drawing to fit a WxH page (none: file units)")
-      ->capture_default_str();
-  command->add_option("--margin", o->margin, "space around the drawing (default 5 mm / 0.2 in)");
+  AddPageOptions(command, &o->fit, &o->origin, &o->margin);
   command->add_option("--tolerance", o->tolerance,
                       "largest distance of the drawing from the exact curves (default 0.05 mm / "
                       "0.002 in)");
@@ -140,7 +155,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
 }
 
-int RunStream(const StreamOptions& o) {
+int RunStream(const StreamOptions& options) {
+  // Messages name standard input "<stdin>", as the reader does.
+  StreamOptions o = options;
+  if (o.file == "-") o.file = "<stdin>";
   if (o.hidden == "remove") {
     throw InputError(
         "--hidden remove: the device evaluates whole isolines itself, so stream cannot leave "
@@ -165,10 +183,12 @@ int RunStream(const StreamOptions& o) {
   }
   const ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadPatchFile(options.file, o.input_format);
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
+  PlacePage(o.fit, o.origin, o.units, 1.0, set, &scaled);
+  RefuseOutsideTravel(PlanPage(set, scaled, o.units), machine, scaled.origin);
   const StreamJob job = BuildStreamJob(set, scaled, machine, o.units);
   try {
     if (sim) return RunSimulated(o, set, job, scaled, o.units);

@@ -14,12 +14,15 @@ namespace fdsurf::host {
 
 struct StreamOptions {
   std::string file;
+  std::string input_format;
   std::string device = "sim";
   // The drawing, as for `fdsurf plot`.
   std::string lines = "8";
   std::string view = "iso";
   std::string units = "mm";
-  std::string fit = "200x150";
+  /// --fit and --origin as typed, "" when left out (PlacePage's defaults).
+  std::string fit;
+  std::string origin;
   std::string margin;
   std::string tolerance;
   int dims = 2;

@@ -523,7 +523,10 @@ QuadricMesh MeshFileConstruction(TriangleMesh file, double* tolerance) {
 }
 
 PatchSet MeshFileAsPatchSet(const std::string& path) {
-  TriangleMesh file = ReadMeshFile(path);
+  return MeshAsPatchSet(ReadMeshFile(path), path);
+}
+
+PatchSet MeshAsPatchSet(TriangleMesh file, const std::string& path) {
   PatchSet set;
   set.notes = std::move(file.notes);
   double tolerance = 0;

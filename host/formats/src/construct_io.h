@@ -41,6 +41,9 @@ void AddConstructions(const nlohmann::json& construct, const std::string& file, 
 /// InputError naming the file.
 PatchSet MeshFileAsPatchSet(const std::string& path);
 
+/// The same for a mesh already read; `path` names it in messages and notes.
+PatchSet MeshAsPatchSet(TriangleMesh file, const std::string& path);
+
 /// Appends the curves of every entry in `curves` (a JSON array) to `set`.
 void AddCurves(const nlohmann::json& curves, const std::string& file, PatchSet* set);
 

@@ -693,12 +693,4 @@ PatchSet ReadGcode(const std::string& text, const std::string& name,
   return interpreter.Finish();
 }
 
-bool IsGcodePath(const std::string& path) {
-  const std::size_t dot = path.rfind('.');
-  if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return false;
-  std::string suffix = path.substr(dot + 1);
-  for (char& c : suffix) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return suffix == "gcode" || suffix == "nc" || suffix == "ngc" || suffix == "g" || suffix == "gco";
-}
-
 }  // namespace fdsurf::host

@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/host/patch_io.h"
 
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -304,22 +306,125 @@ Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
                     "' (expected bezier, hermite, bspline, catmull-rom or power)");
 }
 
-PatchSet ReadPatchFile(const std::string& path) {
-  std::string lower = path.substr(path.size() >= 4 ? path.size() - 4 : 0);
+namespace {
+
+using TextReader = PatchSet (*)(const std::string& text, const std::string& name);
+
+PatchSet ParseObjMesh(const std::string& text, const std::string& name) {
+  return MeshAsPatchSet(ParseObj(text, name), name);
+}
+
+PatchSet ParsePlyMesh(const std::string& bytes, const std::string& name) {
+  return MeshAsPatchSet(ParsePly(bytes, name), name);
+}
+
+// A G-code program with the reader's default conventions (gcode_io.h).
+PatchSet ReadGcodeProgram(const std::string& text, const std::string& name) {
+  return ReadGcode(text, name);
+}
+
+// Every input format: its --input-format name, the suffixes that say it (in
+// any case) and its reader; a reader this build does not have is nullptr.
+// Adding a format is one row.
+struct InputFormat {
+  const char* name;
+  std::array<const char*, 5> suffixes;
+  TextReader read;
+};
+
+constexpr InputFormat kInputFormats[] = {
+    {"bpt", {".bpt"}, ParseBpt},
+    {"json", {".json"}, ParseJson},
+    {"obj", {".obj"}, ParseObjMesh},
+    {"ply", {".ply"}, ParsePlyMesh},
+    {"svg", {".svg"}, nullptr},
+    {"gcode", {".gcode", ".nc", ".ngc", ".g", ".gco"}, ReadGcodeProgram},
+};
+
+const InputFormat* FormatNamed(const std::string& name) {
+  for (const InputFormat& format : kInputFormats) {
+    if (name == format.name) return &format;
+  }
+  return nullptr;
+}
+
+const InputFormat* FormatBySuffix(const std::string& path) {
+  std::string lower = path;
   for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (lower == ".obj" || lower == ".ply") return MeshFileAsPatchSet(path);
+  for (const InputFormat& format : kInputFormats) {
+    for (const char* suffix : format.suffixes) {
+      if (suffix != nullptr && EndsWith(lower, suffix)) return &format;
+    }
+  }
+  return nullptr;
+}
+
+// The format by the first characters of the content, for standard input and
+// files without a known suffix: '{' JSON, '<' SVG, "ply" PLY, a digit BPT
+// (its patch count), an OBJ statement or comment, a G-code word or comment.
+const InputFormat* FormatByContent(const std::string& text) {
+  const std::size_t first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return nullptr;
+  const std::string_view head = std::string_view(text).substr(first, 4);
+  const char c = head[0];
+  if (c == '{') return FormatNamed("json");
+  if (c == '<') return FormatNamed("svg");
+  if (head.substr(0, 3) == "ply") return FormatNamed("ply");
+  if (std::isdigit(static_cast<unsigned char>(c)) != 0) return FormatNamed("bpt");
+  const std::string_view word = head.substr(0, head.find_first_of(" \t"));
+  if (c == '#' || word == "v" || word == "vn" || word == "vt" || word == "f" || word == "o" ||
+      word == "g") {
+    return FormatNamed("obj");
+  }
+  if (c == ';' || c == '(' || c == '%' || c == 'G' || c == 'g' || c == 'M' || c == 'N') {
+    return FormatNamed("gcode");
+  }
+  return nullptr;
+}
+
+std::string ReadAll(const std::string& path, const std::string& name) {
+  std::ostringstream buffer;
+  if (path == "-") {
+    buffer << std::cin.rdbuf();
+    if (std::cin.bad()) throw InputError(name + ": read error");
+    return buffer.str();
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
-  std::ostringstream buffer;
   buffer << in.rdbuf();
   if (in.bad()) throw InputError(path + ": read error");
-  const std::string text = buffer.str();
-  if (IsGcodePath(path)) return ReadGcode(text, path);
-  if (EndsWith(path, ".json")) return ParseJson(text, path);
-  if (EndsWith(path, ".bpt")) return ParseBpt(text, path);
-  const std::size_t first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos) throw InputError(path + ": the file is empty");
-  return text[first] == '{' ? ParseJson(text, path) : ParseBpt(text, path);
+  return buffer.str();
+}
+
+}  // namespace
+
+PatchSet ReadPatchFile(const std::string& path, const std::string& format_name) {
+  const std::string name = path == "-" ? "<stdin>" : path;
+  const InputFormat* format = nullptr;
+  if (!format_name.empty()) {
+    format = FormatNamed(format_name);
+    if (format == nullptr) {
+      throw InputError("--input-format: '" + format_name +
+                       "' is not bpt, json, obj, ply, svg or gcode");
+    }
+  }
+  if (format == nullptr && path != "-") format = FormatBySuffix(path);
+  const std::string text = ReadAll(path, name);
+  if (format == nullptr) {
+    if (text.find_first_not_of(" \t\r\n") == std::string::npos) {
+      throw InputError(name + ": the " + (path == "-" ? "input" : "file") + " is empty");
+    }
+    format = FormatByContent(text);
+    if (format == nullptr) {
+      throw InputError(name +
+                       ": cannot tell the format from the content; say it with --input-format "
+                       "bpt|json|obj|ply|svg|gcode");
+    }
+  }
+  if (format->read == nullptr) {
+    throw InputError(name + ": " + format->name + " input is not available");
+  }
+  return format->read(text, name);
 }
 
 }  // namespace fdsurf::host

@@ -370,6 +370,78 @@ std::array<double, 3> OutputMap::Apply(const Point3& p) const {
   return out;
 }
 
+namespace {
+
+std::string PageText(const std::array<double, 2>& page) {
+  return FormatNumber(page[0]) + "x" + FormatNumber(page[1]);
+}
+
+// --origin keep: no scaling, no offset in the plane (nor in depth: 3-D keeps
+// the file's Z). The page is --fit's, the file's own or the drawing's far
+// edge plus the margin.
+void PlaceKept(const PatchSet& set, const ToolpathOptions& options, const Box& box,
+               Toolpath* path) {
+  const double scale = options.units_scale;
+  path->map.scale = scale;
+  path->map.offset = {0.0, 0.0, 0.0};
+  const std::array<double, 2> lo{box.lo[0] * scale, box.lo[1] * scale};
+  const std::array<double, 2> hi{box.hi[0] * scale, box.hi[1] * scale};
+  if (options.fit) {
+    const auto& page = *options.fit;
+    // A few ulps of slack: the extent is computed, the page typed.
+    const double slack = 1e-9 * std::max({page[0], page[1], 1.0});
+    if (lo[0] < -slack || lo[1] < -slack || hi[0] > page[0] + slack || hi[1] > page[1] + slack) {
+      throw OptionError("fit", PageText(page),
+                        "is a page the drawing does not lie inside as it is (x " +
+                            FormatNumber(lo[0]) + ".." + FormatNumber(hi[0]) + ", y " +
+                            FormatNumber(lo[1]) + ".." + FormatNumber(hi[1]) +
+                            "); --origin keep does not scale or move it: use --origin center or "
+                            "min to fit it, or a larger page");
+    }
+    path->width = page[0];
+    path->height = page[1];
+  } else if (set.page) {
+    path->width = (*set.page)[0] * scale;
+    path->height = (*set.page)[1] * scale;
+  } else {
+    path->width = std::max(hi[0], 0.0) + options.margin;
+    path->height = std::max(hi[1], 0.0) + options.margin;
+  }
+}
+
+// --origin center or min: scaled to fit the page inside the margin (or at
+// the unit factor without a page, on a page of the drawing plus margins).
+void PlaceFitted(const ToolpathOptions& options, const Box& box, Toolpath* path) {
+  const double bw = box.hi[0] - box.lo[0];
+  const double bh = box.hi[1] - box.lo[1];
+  double scale = options.units_scale;
+  if (options.fit) {
+    const double w = (*options.fit)[0] - 2 * options.margin;
+    const double h = (*options.fit)[1] - 2 * options.margin;
+    if (!(w > 0 && h > 0)) {
+      throw OptionError("fit", "",
+                        "the page " + PageText(*options.fit) +
+                            " leaves no room inside the margin of " + FormatNumber(options.margin));
+    }
+    if (bw <= 0 && bh <= 0)
+      throw OptionError("fit", "", "the drawing is a single point in this view");
+    scale = std::min(bw > 0 ? w / bw : HUGE_VAL, bh > 0 ? h / bh : HUGE_VAL);
+    path->width = (*options.fit)[0];
+    path->height = (*options.fit)[1];
+  } else {
+    path->width = bw * scale + 2 * options.margin;
+    path->height = bh * scale + 2 * options.margin;
+  }
+  path->map.scale = scale;
+  const bool center = options.origin == PageOrigin::kCenter;
+  path->map.offset = {
+      (center ? (path->width - bw * scale) / 2 : options.margin) - box.lo[0] * scale,
+      (center ? (path->height - bh * scale) / 2 : options.margin) - box.lo[1] * scale,
+      options.dims == 3 ? -box.hi[2] * scale : 0.0};
+}
+
+}  // namespace
+
 Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units) {
   if (options.lines_s == 1 || options.lines_t == 1 || options.lines_s < 0 || options.lines_t < 0 ||
       options.lines_s > kMaxPatchSteps + 1 || options.lines_t > kMaxPatchSteps + 1) {
@@ -398,34 +470,18 @@ Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std
   path.units = units;
   path.quantum = options.quantum;
   path.map.view = options.view;
-
   const Box box = DrawingBox(set, options);
-  const double bw = box.hi[0] - box.lo[0];
-  const double bh = box.hi[1] - box.lo[1];
-  double scale = options.units_scale;
-  if (options.fit) {
-    const double w = (*options.fit)[0] - 2 * options.margin;
-    const double h = (*options.fit)[1] - 2 * options.margin;
-    if (!(w > 0 && h > 0)) {
-      throw OptionError("fit", "",
-                        "the page " + FormatNumber((*options.fit)[0]) + "x" +
-                            FormatNumber((*options.fit)[1]) +
-                            " leaves no room inside the margin of " + FormatNumber(options.margin));
-    }
-    if (bw <= 0 && bh <= 0)
-      throw OptionError("fit", "", "the drawing is a single point in this view");
-    scale = std::min(bw > 0 ? w / bw : HUGE_VAL, bh > 0 ? h / bh : HUGE_VAL);
-    path.width = (*options.fit)[0];
-    path.height = (*options.fit)[1];
+  if (options.origin == PageOrigin::kKeep) {
+    PlaceKept(set, options, box, &path);
   } else {
-    path.width = bw * scale + 2 * options.margin;
-    path.height = bh * scale + 2 * options.margin;
+    PlaceFitted(options, box, &path);
   }
-  path.map.scale = scale;
+  const double scale = path.map.scale;
   path.depth = options.dims == 3 ? (box.hi[2] - box.lo[2]) * scale : 0.0;
-  path.map.offset = {(path.width - bw * scale) / 2 - box.lo[0] * scale,
-                     (path.height - bh * scale) / 2 - box.lo[1] * scale,
-                     options.dims == 3 ? -box.hi[2] * scale : 0.0};
+  for (int c = 0; c < 2; ++c) {
+    path.drawing_lo[c] = box.lo[c] * scale + path.map.offset[c];
+    path.drawing_hi[c] = box.hi[c] * scale + path.map.offset[c];
+  }
   return path;
 }
 

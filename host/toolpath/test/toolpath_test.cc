@@ -237,6 +237,83 @@ TEST(Toolpath, FitPlacesTheDrawingInsideThePage) {
   EXPECT_NEAR((hi[0] - lo[0]) * q, 190, o.tolerance);
 }
 
+// One Bézier curve from (10, 10) to (40, 30), monotone in x and y, so its
+// extent in the top view is exactly x 10..40, y 10..30 (its end points).
+PatchSet CurveFrom10To40() {
+  PatchSet set;
+  set.units = "mm";
+  Curve curve;
+  curve.basis = Basis::kBezier;
+  curve.g = {Point3{10, 10, 0}, Point3{20, 10, 0}, Point3{30, 20, 0}, Point3{40, 30, 0}};
+  curve.origin = "test curve";
+  set.curves.push_back(curve);
+  return set;
+}
+
+// The page under each --origin, against the numbers worked out by hand for
+// the curve above (not from the code under test).
+TEST(Toolpath, OriginKeepLeavesTheFilesCoordinates) {
+  ToolpathOptions o = Options("top", 0.05, 2, StepMode::kAdaptive);
+  o.origin = PageOrigin::kKeep;
+  o.margin = 5;
+  const PatchSet set = CurveFrom10To40();
+  const Toolpath path = PlanPage(set, o, "mm");
+  EXPECT_EQ(path.map.scale, 1.0);
+  EXPECT_EQ(path.map.offset, (std::array<double, 3>{0, 0, 0}));
+  // No page: from 0 to the far edge plus the margin.
+  EXPECT_DOUBLE_EQ(path.width, 45);
+  EXPECT_DOUBLE_EQ(path.height, 35);
+  EXPECT_DOUBLE_EQ(path.drawing_lo[0], 10);
+  EXPECT_DOUBLE_EQ(path.drawing_hi[1], 30);
+  // The file's own page, in output units (a file in inches drawn in mm).
+  PatchSet paged = set;
+  paged.page = std::array<double, 2>{4, 3};
+  o.units_scale = 25.4;
+  const Toolpath own = PlanPage(paged, o, "mm");
+  EXPECT_DOUBLE_EQ(own.width, 101.6);
+  EXPECT_DOUBLE_EQ(own.height, 76.2);
+  EXPECT_EQ(own.map.scale, 25.4);
+  // A --fit page is taken when the drawing lies inside it as it is...
+  o.units_scale = 1;
+  o.fit = std::array<double, 2>{40, 30};
+  const Toolpath fitted = PlanPage(set, o, "mm");
+  EXPECT_EQ(fitted.map.scale, 1.0);
+  EXPECT_EQ(fitted.width, 40);
+  // ...and refused when it does not (it is never scaled or moved).
+  o.fit = std::array<double, 2>{39.9, 30};
+  EXPECT_THROW((void)PlanPage(set, o, "mm"), OptionError);
+}
+
+TEST(Toolpath, OriginMinAndCenterPlaceTheDrawing) {
+  ToolpathOptions o = Options("top", 0.05, 2, StepMode::kAdaptive);
+  o.margin = 5;
+  o.origin = PageOrigin::kMin;
+  const PatchSet set = CurveFrom10To40();
+  // Without a page: at the unit scale, lower-left at the margin.
+  const Toolpath min = PlanPage(set, o, "mm");
+  EXPECT_DOUBLE_EQ(min.drawing_lo[0], 5);
+  EXPECT_DOUBLE_EQ(min.drawing_lo[1], 5);
+  EXPECT_DOUBLE_EQ(min.width, 40);
+  EXPECT_DOUBLE_EQ(min.height, 30);
+  // On a 100 x 100 page, margin 5: scale 90/30 = 3 (the width decides),
+  // lower-left at (5, 5) for min; centred, the 60-high drawing starts at 20.
+  o.fit = std::array<double, 2>{100, 100};
+  const Toolpath fitted_min = PlanPage(set, o, "mm");
+  EXPECT_DOUBLE_EQ(fitted_min.map.scale, 3);
+  EXPECT_NEAR(fitted_min.drawing_lo[1], 5, 1e-12);
+  o.origin = PageOrigin::kCenter;
+  const Toolpath center = PlanPage(set, o, "mm");
+  EXPECT_NEAR(center.drawing_lo[0], 5, 1e-12);
+  EXPECT_NEAR(center.drawing_lo[1], 20, 1e-12);
+  EXPECT_NEAR(center.drawing_hi[1], 80, 1e-12);
+  // The drawn points agree with the planned extent (the start is (10, 10) mapped).
+  const Toolpath drawn = BuildToolpath(set, o, "mm");
+  ASSERT_FALSE(drawn.strokes.empty());
+  const auto& first = drawn.strokes[0].points.front();
+  EXPECT_EQ(first[0], 5000);
+  EXPECT_EQ(first[1], 20000);
+}
+
 TEST(Toolpath, PlanningKeepsEverySegmentAndCutsTravel) {
   const PatchSet set = Teapot();
   ToolpathOptions o = Options("iso", 0.05, 2, StepMode::kAdaptive);

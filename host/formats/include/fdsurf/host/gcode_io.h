@@ -40,7 +40,4 @@ struct GcodeReadOptions {
 PatchSet ReadGcode(const std::string& text, const std::string& name,
                    const GcodeReadOptions& options = {});
 
-/// True for the suffixes read as G-code: .gcode .nc .ngc .g .gco (any case).
-bool IsGcodePath(const std::string& path);
-
 }  // namespace fdsurf::host

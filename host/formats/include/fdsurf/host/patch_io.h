@@ -11,13 +11,16 @@
 
 namespace fdsurf::host {
 
-/// Reads a BPT or JSON patch file, an OBJ or PLY triangle mesh drawn as
-/// quadric Hermite pieces (curves; docs/formats.md), or a G-code program
-/// (gcode_io.h, default options). The format is taken from the extension
-/// (.bpt, .json; .obj, .ply, .gcode .nc .ngc .g .gco in any case) or, failing that, from
-/// the first non-blank character. Throws InputError on anything malformed or
-/// a mesh the construction refuses.
-PatchSet ReadPatchFile(const std::string& path);
+/// Reads a BPT or JSON patch file, or an OBJ or PLY triangle mesh drawn as
+/// quadric Hermite pieces (curves; docs/formats.md). `path` "-" reads all of
+/// standard input, named "<stdin>" in messages. The format is `format` when
+/// given (bpt, json, obj, ply, svg, gcode), else the suffix's (.bpt, .json,
+/// .obj, .ply, .svg, .gcode/.nc/.ngc, in any case), else the content's: '{'
+/// JSON, '<' SVG, "ply" PLY, a digit BPT, an OBJ statement or '#' comment, a
+/// G-code word or comment. Throws InputError on an unknown `format`, content
+/// whose format cannot be told, a format this build cannot read, anything
+/// malformed or a mesh the construction refuses.
+PatchSet ReadPatchFile(const std::string& path, const std::string& format = "");
 
 /// The construction a mesh file is drawn by (docs/formats.md): μ from its
 /// normals, the normals turned where the triangles' conditions need it,

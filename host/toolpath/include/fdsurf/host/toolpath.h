@@ -55,6 +55,17 @@ enum class StepMode {
   kStepExact,
 };
 
+/// Where the drawing goes on the page (--origin; docs/toolpaths.md, "The page").
+enum class PageOrigin {
+  /// The file's coordinates are the machine's: the view and the unit factor
+  /// only, no scaling to a page and no offset.
+  kKeep,
+  /// Centred on the page.
+  kCenter,
+  /// The drawing's lower-left corner at (margin, margin).
+  kMin,
+};
+
 struct ToolpathOptions {
   /// Largest distance between the drawn polyline and the exact curve, in
   /// output units (Euclidean, in the output's 2 or 3 dimensions).
@@ -66,10 +77,14 @@ struct ToolpathOptions {
   View view;
   /// Output units per file unit (25.4 for a file in inches drawn in mm).
   double units_scale = 1.0;
-  /// When set, the drawing is scaled uniformly to fit this page (output units).
+  /// When set, the page (output units). Under kCenter and kMin the drawing is
+  /// scaled uniformly to fit it inside the margin; under kKeep it is not
+  /// scaled and must lie inside [0, W] × [0, H] as it is.
   std::optional<std::array<double, 2>> fit;
-  /// Space kept around the drawing (output units).
+  /// Space kept around the drawing (output units); not used under kKeep
+  /// with a page, and added beyond the drawing's far edge under kKeep without one.
   double margin = 0.0;
+  PageOrigin origin = PageOrigin::kCenter;
   /// Output resolution: every point is a whole multiple of it.
   Quantum quantum;
   /// 2: the view plane; 3: plus depth (for CNC).
@@ -120,13 +135,19 @@ struct Toolpath {
   double width = 0;
   double height = 0;
   /// The drawing's extent along the view's depth, output units (3-D output
-  /// puts its top at Z = 0 and its bottom at Z = -depth).
+  /// puts its top at Z = 0 and its bottom at Z = -depth, except under
+  /// PageOrigin::kKeep, where Z is the file's own).
   double depth = 0;
   /// The largest distance promised between a stroke and its exact curve,
   /// output units (ToolpathOptions::tolerance); 0 when unknown.
   double tolerance = 0;
   /// The layers' names (PatchSet::layers); empty: one unnamed layer.
   std::vector<std::string> layers;
+  /// The drawing's exact extent on the page (output units, before rounding
+  /// to the quantum): lower-left and upper-right corners. Under kKeep it may
+  /// reach below 0 (the commands decide whether that is allowed).
+  std::array<double, 2> drawing_lo{};
+  std::array<double, 2> drawing_hi{};
   std::vector<Stroke> strokes;
 };
 
@@ -134,9 +155,13 @@ struct Toolpath {
 using Progress = std::function<void(std::size_t, std::size_t, std::size_t)>;
 
 /// Checks the options and plans the page: the output map (view, scale to
-/// the fit, centring offset), width and height. No strokes. Throws
-/// OptionError ("lines", "tolerance", "fit") for options that cannot be met
-/// and InputError for a file with nothing to draw.
+/// the fit, the offset options.origin asks for), width, height and the
+/// drawing's extent. Under kKeep without a fit the page is the file's own
+/// (set.page, times units_scale) or else runs from 0 to the drawing's far
+/// edge plus the margin. No strokes. Throws OptionError ("lines",
+/// "tolerance", "fit"; "fit" also for kKeep with a page the unscaled drawing
+/// does not lie inside) for options that cannot be met and InputError for a
+/// file with nothing to draw.
 Toolpath PlanPage(const PatchSet& set, const ToolpathOptions& options, const std::string& units);
 
 /// The patch's geometry in output space, in the engine's format: every
