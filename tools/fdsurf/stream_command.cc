@@ -136,6 +136,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
+  command->add_flag("--no-pause", o->no_pause,
+                    "between layers, say that the pen is to be changed but do not wait for Enter");
 }
 
 int RunStream(const StreamOptions& o) {

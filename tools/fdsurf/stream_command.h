@@ -47,6 +47,9 @@ struct StreamOptions {
   std::string waveform;
   int png_width = 1600;
   bool quiet = false;
+  /// Do not wait for Enter between layers (the pen change); the runners
+  /// also go on without waiting when stdin is not a terminal.
+  bool no_pause = false;
 };
 
 /// Adds the options of `stream` to `command`.
