@@ -153,6 +153,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--hidden", o->hidden, "show (remove: plot and render only)")
       ->check(CLI::IsMember({"show", "remove"}));
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
+  command->add_flag("--no-pause", o->no_pause,
+                    "between layers, say that the pen is to be changed but do not wait for Enter");
 }
 
 int RunStream(const StreamOptions& options) {

@@ -52,6 +52,9 @@ struct StreamOptions {
   bool quiet = false;
   /// --hidden: only "show"; "remove" is refused (the device draws whole isolines).
   std::string hidden = "show";
+  /// Do not wait for Enter between layers (the pen change); the runners
+  /// also go on without waiting when stdin is not a terminal.
+  bool no_pause = false;
 };
 
 /// Adds the options of `stream` to `command`.

@@ -153,67 +153,196 @@ protocol::Command PatchCommandFor(const Patch& patch, const ToolpathOptions& t,
   return command;
 }
 
-// The file's curves, in file order: CURVE commands with the pen down, and a
-// pen-up move only where a curve does not start where the one before ended
-// (so a chain is drawn in one stroke).
-void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
-                      StreamJob* job) {
-  bool pen_down = false;
-  bool placed = false;
-  std::array<std::int32_t, 3> at{};
-  const auto pen = [&](bool down) {
+// A curve drawn the other way round, exactly: a Bézier's control points in
+// reverse order; a Hermite's ends swapped and its tangents swapped and
+// negated. Other bases are not reversed (CurveReversible).
+bool CurveReversible(const Curve& curve) {
+  return curve.basis == Basis::kBezier || curve.basis == Basis::kHermite;
+}
+
+Curve Reversed(const Curve& curve) {
+  Curve out = curve;
+  if (curve.basis == Basis::kBezier) {
+    out.g = {curve.g[3], curve.g[2], curve.g[1], curve.g[0]};
+  } else {
+    out.g[0] = curve.g[1];
+    out.g[1] = curve.g[0];
+    for (int c = 0; c < 3; ++c) {
+      out.g[2][static_cast<std::size_t>(c)] = -curve.g[3][static_cast<std::size_t>(c)];
+      out.g[3][static_cast<std::size_t>(c)] = -curve.g[2][static_cast<std::size_t>(c)];
+    }
+  }
+  return out;
+}
+
+// One curve as the device will get it: the CURVE command, and its first and
+// last points as the device computes them (integer steps).
+struct DeviceCurve {
+  protocol::Command command;
+  std::array<std::int32_t, 3> start{};
+  std::array<std::int32_t, 3> end{};
+};
+
+DeviceCurve ToDevice(const Curve& curve, const ToolpathOptions& t, const MachineOptions& machine,
+                     const StreamJob& job) {
+  DeviceCurve out;
+  protocol::Command& command = out.command;
+  command.type = protocol::MessageType::kCurve;
+  command.seq = 0;
+  protocol::CurveCommand& body = command.body.curve;
+  body.basis = curve.basis;
+  body.dims = static_cast<std::uint8_t>(t.dims);
+  body.tolerance_q8 = job.tolerance_q8;
+  for (auto& axis : body.geometry) axis = CurveGeometry1{};
+  CurveToQuanta(curve, job.page.map, machine.step, t.dims, body.geometry);
+  PowerCurve1 power[protocol::kMaxAxes];
+  const Status status = CurvePowerCoefficients(body.geometry, curve.basis, power);
+  if (status != Status::kOk) {
+    throw EngineError(curve.origin + ": " + StatusMessage(status) + "; use a coarser step");
+  }
+  for (int a = 0; a < protocol::kMaxAxes; ++a) {
+    const auto& k = power[a].c;
+    out.start[static_cast<std::size_t>(a)] = RoundToQuanta(k[3], kCoefficientFracBits);
+    out.end[static_cast<std::size_t>(a)] =
+        RoundToQuanta(k[0] + k[1] + k[2] + k[3], kCoefficientFracBits);
+  }
+  return out;
+}
+
+// One curve in the drawing order: its index and whether it is drawn reversed.
+struct CurveVisit {
+  std::size_t curve = 0;
+  bool reversed = false;
+};
+
+// The order of one layer's curves (file order within it). With keep_order,
+// file order. Otherwise chains (maximal runs of curves that meet end to end,
+// as the device rounds them) are ordered by nearest neighbour from `from`,
+// reversed when every curve of the layer can be reversed exactly.
+std::vector<CurveVisit> OrderLayer(const std::vector<std::size_t>& curves,
+                                   const std::vector<DeviceCurve>& device, bool keep_order,
+                                   bool reversible, const PlanPoint& from) {
+  std::vector<CurveVisit> order;
+  if (keep_order) {
+    for (const std::size_t c : curves) order.push_back(CurveVisit{c, false});
+    return order;
+  }
+  std::vector<std::vector<std::size_t>> chains;
+  for (const std::size_t c : curves) {
+    if (chains.empty() || device[chains.back().back()].end != device[c].start)
+      chains.emplace_back();
+    chains.back().push_back(c);
+  }
+  const auto point = [](const std::array<std::int32_t, 3>& p) {
+    return PlanPoint{static_cast<double>(p[0]), static_cast<double>(p[1]),
+                     static_cast<double>(p[2])};
+  };
+  std::vector<std::array<PlanPoint, 2>> ends;
+  for (const auto& chain : chains) {
+    ends.push_back({point(device[chain.front()].start), point(device[chain.back()].end)});
+  }
+  for (const Visit& visit : OrderNearestNeighbour(ends, reversible, PlanMetric::kSpace, from)) {
+    const auto& chain = chains[visit.index];
+    if (visit.reversed) {
+      for (auto it = chain.rbegin(); it != chain.rend(); ++it)
+        order.push_back(CurveVisit{*it, true});
+    } else {
+      for (const std::size_t c : chain) order.push_back(CurveVisit{c, false});
+    }
+  }
+  return order;
+}
+
+// Appends PEN, MOVE and CURVE commands to the job, tracking the pen.
+class CurveEmitter {
+ public:
+  explicit CurveEmitter(StreamJob* job) : job_(job) {}
+
+  void Pen(bool down) {
+    if (down == pen_down_) return;
     protocol::Command command;
     command.type = protocol::MessageType::kPen;
     command.seq = 0;
     command.body.pen.down = down;
-    job->commands.push_back(command);
-    job->labels.emplace_back(down ? "pen down" : "pen up");
-    pen_down = down;
-  };
-  for (std::size_t c = 0; c < set.curves.size(); ++c) {
-    const Curve& curve = set.curves[c];
-    protocol::Command command;
-    command.type = protocol::MessageType::kCurve;
-    command.seq = 0;
-    protocol::CurveCommand& body = command.body.curve;
-    body.basis = curve.basis;
-    body.dims = static_cast<std::uint8_t>(t.dims);
-    body.tolerance_q8 = job->tolerance_q8;
-    for (auto& axis : body.geometry) axis = CurveGeometry1{};
-    CurveToQuanta(curve, job->page.map, machine.step, t.dims, body.geometry);
-    // The device's first and last points of this curve, computed as it will.
-    PowerCurve1 power[protocol::kMaxAxes];
-    const Status status = CurvePowerCoefficients(body.geometry, curve.basis, power);
-    if (status != Status::kOk) {
-      throw EngineError(curve.origin + ": " + StatusMessage(status) + "; use a coarser step");
-    }
-    std::array<std::int32_t, 3> start{};
-    std::array<std::int32_t, 3> end{};
-    for (int a = 0; a < protocol::kMaxAxes; ++a) {
-      const auto& k = power[a].c;
-      start[static_cast<std::size_t>(a)] = RoundToQuanta(k[3], kCoefficientFracBits);
-      end[static_cast<std::size_t>(a)] =
-          RoundToQuanta(k[0] + k[1] + k[2] + k[3], kCoefficientFracBits);
-    }
-    if (!placed || start != at) {
-      if (pen_down) pen(false);
-      protocol::Command move;
-      move.type = protocol::MessageType::kMove;
-      move.seq = 0;
-      for (int a = 0; a < protocol::kMaxAxes; ++a) {
-        move.body.move.target[a] = start[static_cast<std::size_t>(a)];
-      }
-      job->commands.push_back(move);
-      job->labels.push_back("travel to curve " + std::to_string(c) + " (" + curve.origin + ")");
-    }
-    if (!pen_down) pen(true);
-    job->commands.push_back(command);
-    job->labels.push_back("curve " + std::to_string(c) + " (" + curve.origin + ")");
-    job->curves.push_back(c);
-    at = end;
-    placed = true;
+    job_->commands.push_back(command);
+    job_->labels.emplace_back(down ? "pen down" : "pen up");
+    pen_down_ = down;
   }
-  if (pen_down) pen(false);
+
+  void Move(const std::array<std::int32_t, 3>& target, std::string label) {
+    protocol::Command move;
+    move.type = protocol::MessageType::kMove;
+    move.seq = 0;
+    for (int a = 0; a < protocol::kMaxAxes; ++a) {
+      move.body.move.target[a] = target[static_cast<std::size_t>(a)];
+    }
+    job_->commands.push_back(move);
+    job_->labels.push_back(std::move(label));
+  }
+
+  // A straight curve is one MOVE with the pen down: the device draws the
+  // straight line from where it is (the curve's rounded start) to the same
+  // rounded end point that the CURVE would end at.
+  void Draw(const DeviceCurve& curve, bool straight, std::size_t index, const std::string& origin) {
+    const std::string name = std::to_string(index) + " (" + origin + ")";
+    if (!placed_ || curve.start != at_) {
+      Pen(false);
+      Move(curve.start, "travel to curve " + name);
+    }
+    Pen(true);
+    if (straight) {
+      Move(curve.end, "line " + name);
+    } else {
+      job_->commands.push_back(curve.command);
+      job_->labels.push_back("curve " + name);
+    }
+    job_->curves.push_back(index);
+    at_ = curve.end;
+    placed_ = true;
+  }
+
+  [[nodiscard]] PlanPoint At() const {
+    return {static_cast<double>(at_[0]), static_cast<double>(at_[1]), static_cast<double>(at_[2])};
+  }
+
+ private:
+  StreamJob* job_;
+  bool pen_down_ = false;
+  bool placed_ = false;
+  std::array<std::int32_t, 3> at_{};
+};
+
+// The file's curves, layer by layer in layer order (each layer's start
+// recorded in job->layers when the file has layers), within a layer in the
+// order of OrderLayer. A pen-up move only where a curve does not start where
+// the one before ended (so a chain is drawn in one stroke).
+void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
+                      StreamJob* job) {
+  std::vector<DeviceCurve> device;
+  device.reserve(set.curves.size());
+  std::map<int, std::vector<std::size_t>> by_layer;
+  for (std::size_t c = 0; c < set.curves.size(); ++c) {
+    device.push_back(ToDevice(set.curves[c], t, machine, *job));
+    by_layer[set.layers.empty() ? 0 : set.curves[c].layer].push_back(c);
+  }
+  CurveEmitter emit(job);
+  for (const auto& [layer, curves] : by_layer) {
+    if (!set.layers.empty()) {
+      emit.Pen(false);
+      const std::size_t at = job->commands.size();
+      const auto named = static_cast<std::size_t>(layer);
+      job->layers.push_back(LayerStart{at, named < set.layers.size() ? set.layers[named] : ""});
+    }
+    bool reversible = true;
+    for (const std::size_t c : curves) reversible = reversible && CurveReversible(set.curves[c]);
+    for (const CurveVisit& visit :
+         OrderLayer(curves, device, set.keep_order, reversible, emit.At())) {
+      const Curve& curve = set.curves[visit.curve];
+      emit.Draw(visit.reversed ? ToDevice(Reversed(curve), t, machine, *job) : device[visit.curve],
+                curve.straight, visit.curve, curve.origin);
+    }
+  }
+  emit.Pen(false);
 }
 
 const char* const kAxisNames[3] = {"X", "Y", "Z"};

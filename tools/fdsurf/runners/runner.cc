@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "runner.h"
 
+#include <unistd.h>
+
 #include <cstdio>
+#include <iostream>
 #include <regex>
+#include <string>
 
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/host/errors.h"
@@ -19,8 +23,10 @@ HostLinkOptions LinkOptions() {
   return options;
 }
 
-void Enqueue(const StreamJob& job, HostLink* link) {
-  for (std::size_t k = 0; k < job.commands.size(); ++k) {
+void Enqueue(const StreamJob& job, HostLink* link) { Enqueue(job, link, 0, job.commands.size()); }
+
+void Enqueue(const StreamJob& job, HostLink* link, std::size_t from, std::size_t to) {
+  for (std::size_t k = from; k < to; ++k) {
     const protocol::DecodeResult result = link->Enqueue(job.commands[k], job.labels[k]);
     if (!result.ok()) {
       throw EngineError(job.labels[k] + ": cannot be sent: " + protocol::ErrorName(result.code) +
@@ -96,6 +102,33 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
                static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames),
                rate);
   shown_ = true;
+}
+
+std::size_t NextLayerBoundary(const StreamJob& job, std::size_t from) {
+  // The first layer needs no pen change: the user put its pen in.
+  for (std::size_t k = 1; k < job.layers.size(); ++k) {
+    if (job.layers[k].command > from) return job.layers[k].command;
+  }
+  return job.commands.size();
+}
+
+void PauseForLayer(const StreamOptions& o, const StreamJob& job, std::size_t command,
+                   std::uint64_t executed) {
+  std::size_t index = 0;
+  while (index + 1 < job.layers.size() && job.layers[index].command != command) ++index;
+  std::fprintf(stderr, "fdsurf: layer %zu/%zu '%s': change the pen, then press Enter\n", index + 1,
+               job.layers.size(), job.layers[index].name.c_str());
+  const bool terminal = ::isatty(STDIN_FILENO) != 0;
+  if (o.no_pause || !terminal) {
+    std::fprintf(stderr, "fdsurf: going on without waiting (%s); %llu of %zu commands executed\n",
+                 o.no_pause ? "--no-pause" : "stdin is not a terminal",
+                 static_cast<unsigned long long>(executed), job.commands.size());
+    return;
+  }
+  std::string line;
+  std::getline(std::cin, line);
+  std::fprintf(stderr, "fdsurf: layer %zu/%zu '%s': going on\n", index + 1, job.layers.size(),
+               job.layers[index].name.c_str());
 }
 
 void ProgressLine::Finish() {

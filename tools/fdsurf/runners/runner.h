@@ -41,6 +41,21 @@ HostLinkOptions LinkOptions();
 /// Queues every command of the job on the link; EngineError for a command
 /// the codec refuses (naming its label and field).
 void Enqueue(const StreamJob& job, HostLink* link);
+/// The same for commands [from, to) only.
+void Enqueue(const StreamJob& job, HostLink* link, std::size_t from, std::size_t to);
+
+/// The command index at which the next layer after `from` begins (a
+/// LayerStart other than the first), or the job's size when none does.
+std::size_t NextLayerBoundary(const StreamJob& job, std::size_t from);
+
+/// At a layer boundary (`command` = a LayerStart's command), once the device
+/// has executed everything before it and rests with the pen up: prints
+/// "fdsurf: layer 2/3 'NAME': change the pen, then press Enter" on stderr and
+/// waits for a line on stdin when stdin is a terminal and !o.no_pause;
+/// otherwise says that it goes on without waiting (`executed` commands so
+/// far, for the message). Never blocks when stdin is not a terminal.
+void PauseForLayer(const StreamOptions& o, const StreamJob& job, std::size_t command,
+                   std::uint64_t executed);
 
 /// A device moves at most one step per axis per tick: InputError naming
 /// --speed and --tick-hz when the job's speed needs more.

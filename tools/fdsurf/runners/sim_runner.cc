@@ -75,19 +75,30 @@ sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o) {
 }
 
 // Streams the job to the plotter until every command ran (or the link gave
-// up), with the progress line.
+// up), with the progress line. Layer by layer: the commands of one layer are
+// sent, and only when the link reports them all executed and the device idle
+// (the pen is up before every layer start) is the pen change asked for and
+// the next layer sent. The machine's clock does not run during the pause.
 sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
                                sim::SimulatedPlotter* plotter) {
   HostLink link(LinkOptions());
-  Enqueue(job, &link);
   ProgressLine progress(ShowProgress(o.quiet));
   constexpr std::uint64_t kTimeLimitUs = 24ull * 3600 * 1'000'000;  // a day of machine time
-  sim::RunResult run = plotter->Run(
-      link, kTimeLimitUs,
-      [&](const sim::RunProgress& p) {
-        progress.Show(p.executed, p.total, p.frames_sent, p.time_us * 1e-6);
-      },
-      250'000);
+  sim::RunResult run;
+  for (std::size_t from = 0;;) {
+    const std::size_t to = NextLayerBoundary(job, from);
+    Enqueue(job, &link, from, to);
+    run = plotter->Run(
+        link, kTimeLimitUs,
+        [&](const sim::RunProgress& p) {
+          progress.Show(p.executed, job.commands.size(), p.frames_sent, p.time_us * 1e-6);
+        },
+        250'000);
+    if (!run.finished || to == job.commands.size()) break;
+    progress.Finish();
+    PauseForLayer(o, job, to, run.executed);
+    from = to;
+  }
   progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6, true);
   progress.Finish();
   return run;

@@ -39,15 +39,30 @@ struct StreamedPatch {
   int lines_t = 0;
 };
 
+/// Where a layer of the file's curves begins in StreamJob::commands.
+struct LayerStart {
+  /// Index of the layer's first command (the pen is up before it).
+  std::size_t command = 0;
+  /// PatchSet::layers name (may be empty).
+  std::string name;
+};
+
 struct StreamJob {
   protocol::MachineConfig config{};
   /// CONFIG first, then one PATCH per patch, in drawing order, then the
-  /// file's curves (PEN, MOVE and CURVE commands).
+  /// file's curves (PEN, MOVE and CURVE commands; a straight curve is one
+  /// MOVE with the pen down). The curves go layer by layer; within a layer
+  /// in file order when PatchSet::keep_order, else chains of curves that
+  /// meet end to end are ordered by nearest neighbour (Bézier and Hermite
+  /// chains may be drawn reversed, exactly).
   std::vector<protocol::Command> commands;
   std::vector<std::string> labels;
   std::vector<StreamedPatch> patches;
   /// The file's curves (PatchSet::curves indices), drawn after the patches.
   std::vector<std::size_t> curves;
+  /// The start of every layer of curves, in drawing order, when the file
+  /// has layers (PatchSet::layers not empty); runners pause between them.
+  std::vector<LayerStart> layers;
   /// The page and the map from file units to output units; quantum = step.
   Toolpath page;
   /// Tolerance in steps, and as the devices's 2^-8-step units.
