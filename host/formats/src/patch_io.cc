@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "construct_io.h"
+#include "fdsurf/host/svg_io.h"
 
 namespace fdsurf::host {
 namespace {
@@ -313,10 +314,12 @@ PatchSet ReadPatchFile(const std::string& path) {
   buffer << in.rdbuf();
   if (in.bad()) throw InputError(path + ": read error");
   const std::string text = buffer.str();
+  if (lower == ".svg") return ReadSvg(text, path);
   if (EndsWith(path, ".json")) return ParseJson(text, path);
   if (EndsWith(path, ".bpt")) return ParseBpt(text, path);
   const std::size_t first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw InputError(path + ": the file is empty");
+  if (LooksLikeSvg(text)) return ReadSvg(text, path);
   return text[first] == '{' ? ParseJson(text, path) : ParseBpt(text, path);
 }
 

@@ -11,10 +11,11 @@
 
 namespace fdsurf::host {
 
-/// Reads a BPT or JSON patch file, or an OBJ or PLY triangle mesh drawn as
-/// quadric Hermite pieces (curves; docs/formats.md). The format is taken from
-/// the extension (.bpt, .json; .obj, .ply in any case) or, failing that, from
-/// the first non-blank character. Throws InputError on anything malformed or
+/// Reads a BPT or JSON patch file, an SVG drawing (ReadSvg, default
+/// SvgOptions), or an OBJ or PLY triangle mesh drawn as quadric Hermite
+/// pieces (curves; docs/formats.md). The format is taken from the extension
+/// (.bpt, .json; .svg, .obj, .ply in any case) or, failing that, from the
+/// content (LooksLikeSvg, else the first non-blank character). Throws InputError on anything malformed or
 /// a mesh the construction refuses.
 PatchSet ReadPatchFile(const std::string& path);
 

@@ -1,0 +1,4 @@
+// SPDX-License-Identifier: MIT
+#include "fdsurf/host/svg_io.h"
+
+#include <gtest/gtest.h>
