@@ -15,6 +15,8 @@
 
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/svg_io.h"
 
 namespace fdsurf::host {
 
@@ -153,6 +155,26 @@ void StagedOutputs::Commit() {
     }
   }
   staged_.clear();
+}
+
+PatchSet ReadDrawing(const std::string& file, const std::string& layer, bool quiet) {
+  PatchSet set = ReadPatchFile(file);
+  if (!layer.empty()) SelectLayer(&set, layer);
+  if (!quiet) {
+    for (const std::string& note : set.notes) {
+      if (note.find(": left out: ") != std::string::npos) {
+        std::fprintf(stderr, "fdsurf: note: %s\n", note.c_str());
+      }
+    }
+  }
+  return set;
+}
+
+bool IsFlatDrawing(const PatchSet& set) {
+  if (!set.patches.empty() || set.curves.empty()) return false;
+  return std::all_of(set.curves.begin(), set.curves.end(), [](const Curve& curve) {
+    return std::all_of(curve.g.begin(), curve.g.end(), [](const Point3& p) { return p[2] == 0; });
+  });
 }
 
 bool ShowProgress(bool quiet) {

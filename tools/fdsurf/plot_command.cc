@@ -42,7 +42,7 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
   t.lines_t = lines[1];
-  t.view = ParseView(o.view);
+  t.view = ParseView(o.view.empty() ? "iso" : o.view);
   if (!o.fit.empty()) {
     auto page = ParsePage(o.fit);
     t.fit = std::array<double, 2>{page[0] * to_work, page[1] * to_work};
@@ -132,7 +132,8 @@ int RunPlot(const PlotOptions& o, bool render_only) {
       render_only ? "png" : (o.format.empty() ? FormatFromName(o.output) : o.format);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadDrawing(o.file, o.layer, o.quiet);
+  if (o.view.empty() && IsFlatDrawing(set)) t.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
 
@@ -175,7 +176,8 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
   command
       ->add_option(
           "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+          "drawing: patches (.bpt, .json), an SVG drawing (.svg) or a triangle mesh (.obj, "
+          ".ply); see docs/formats.md")
       ->required();
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();
@@ -198,8 +200,10 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
       ->capture_default_str();
-  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")
-      ->capture_default_str();
+  command->add_option("--view", o->view,
+                      "top, front, side, iso or AZ,EL (degrees); default iso, top for a flat "
+                      "drawing (SVG)");
+  command->add_option("--layer", o->layer, "draw only this layer: its name or number (1, 2, ...)");
   command->add_option("--units", o->units, "units of the output and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();

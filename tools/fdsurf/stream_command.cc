@@ -21,7 +21,7 @@ ToolpathOptions DrawingOptions(const StreamOptions& o) {
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
   t.lines_t = lines[1];
-  t.view = ParseView(o.view);
+  t.view = ParseView(o.view.empty() ? "iso" : o.view);
   if (!o.fit.empty() && o.fit != "none") {
     const auto page = ParsePage(o.fit);
     t.fit = std::array<double, 2>{page[0], page[1]};
@@ -62,7 +62,8 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command
       ->add_option(
           "FILE", o->file,
-          "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); see docs/formats.md")
+          "drawing: patches (.bpt, .json), an SVG drawing (.svg) or a triangle mesh (.obj, "
+          ".ply); see docs/formats.md")
       ->required();
   command
       ->add_option("--device", o->device,
@@ -73,8 +74,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
       ->capture_default_str();
-  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")
-      ->capture_default_str();
+  command->add_option("--view", o->view,
+                      "top, front, side, iso or AZ,EL (degrees); default iso, top for a flat "
+                      "drawing (SVG)");
+  command->add_option("--layer", o->layer, "draw only this layer: its name or number (1, 2, ...)");
   command->add_option("--units", o->units, "units of the drawing and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
@@ -155,9 +158,10 @@ int RunStream(const StreamOptions& o) {
   if (sim && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000");
   }
-  const ToolpathOptions drawing = DrawingOptions(o);
+  ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadPatchFile(o.file);
+  const PatchSet set = ReadDrawing(o.file, o.layer, o.quiet);
+  if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);

@@ -301,7 +301,7 @@ void Reader::Element(const pugi::xml_node& node, const Context& parent) {
     }
   }
   if (kind == "g" || kind == "a") {
-    if (parent.depth == 1 && std::string(node.attribute("inkscape:groupmode").value()) == "layer") {
+    if (parent.depth == 0 && std::string(node.attribute("inkscape:groupmode").value()) == "layer") {
       std::string label = node.attribute("inkscape:label").value();
       if (label.empty()) label = node.attribute("id").value();
       if (label.empty()) label = "layer " + std::to_string(inkscape_layers_.size() + 1);
@@ -345,11 +345,13 @@ void Reader::Viewport(const pugi::xml_node& node, const pugi::xml_node& size_fro
     }
     return Length(size_from, attribute, whole);
   };
-  const double x = Length(size_from, "x", 0);
-  const double y = Length(size_from, "y", 0);
+  // A <use> has already moved its symbol by its own x and y.
+  if (node == size_from) {
+    context.to_out =
+        context.to_out.After({1, 0, 0, 1, Length(node, "x", 0), Length(node, "y", 0)});
+  }
   const double width = percent_or("width", context.viewport[0]);
   const double height = percent_or("height", context.viewport[1]);
-  context.to_out = context.to_out.After({1, 0, 0, 1, x, y});
   if (node.attribute("viewBox")) {
     context.to_out = context.to_out.After(ViewBox(node, width, height));
     const std::vector<double> box = svg::ParseNumberList(node.attribute("viewBox").value());
