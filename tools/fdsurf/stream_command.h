@@ -17,7 +17,7 @@ struct StreamOptions {
   std::string device = "sim";
   // The drawing, as for `fdsurf plot`.
   std::string lines = "8";
-  std::string view;  // empty: iso, or top for a flat drawing (IsFlatDrawing)
+  std::string view;   // empty: iso, or top for a flat drawing (IsFlatDrawing)
   std::string layer;  // --layer NAME|N, empty: all
   std::string units = "mm";
   std::string fit = "200x150";

@@ -55,8 +55,8 @@ void CurveSink::Arc(const Vec2& from, double rx, double ry, double rotation_deg,
   // page: T(u, v) = to_out(centre + R(rotation)·(rx·u, ry·v)).
   const double cs = std::cos(arc.rotation);
   const double sn = std::sin(arc.rotation);
-  const Affine ellipse{cs * arc.rx, sn * arc.rx, -sn * arc.ry, cs * arc.ry, arc.centre[0],
-                       arc.centre[1]};
+  const Affine ellipse{cs * arc.rx, sn * arc.rx,   -sn * arc.ry,
+                       cs * arc.ry, arc.centre[0], arc.centre[1]};
   const Affine t = to_out_.After(ellipse);
   // Pieces of at most 90°: a unit-circle arc of half-angle h ≤ 45° is the
   // rational quadratic (cos a, sin a), (cos m, sin m)/cos h, (cos b, sin b)
@@ -69,12 +69,12 @@ void CurveSink::Arc(const Vec2& from, double rx, double ry, double rotation_deg,
   const Vec2 start = to_out_.Apply(from);
   const Vec2 end = to_out_.Apply(to);
   const double magnitude = std::abs(t.e) + std::abs(t.f) + t.MaxStretch() * 2;
-  const double margin = 32 * std::numeric_limits<double>::epsilon() * magnitude +
-                        std::max(Distance(t.Apply({std::cos(arc.theta1), std::sin(arc.theta1)}),
-                                          start),
-                                 Distance(t.Apply({std::cos(arc.theta1 + arc.delta),
-                                                   std::sin(arc.theta1 + arc.delta)}),
-                                          end));
+  const double margin =
+      32 * std::numeric_limits<double>::epsilon() * magnitude +
+      std::max(
+          Distance(t.Apply({std::cos(arc.theta1), std::sin(arc.theta1)}), start),
+          Distance(t.Apply({std::cos(arc.theta1 + arc.delta), std::sin(arc.theta1 + arc.delta)}),
+                   end));
   if (!(margin < arc_tolerance_ / 2)) {
     throw SyntaxError("the arc cannot be drawn within the arc tolerance " +
                       FormatNumber(arc_tolerance_) + " mm: rounding alone moves it by " +

@@ -102,8 +102,7 @@ CentreArc EndpointToCentre(const Vec2& from, double rx, double ry, double rotati
 /// half of it); ConstructionError passes through from ArcToCubics.
 class CurveSink : public PathSink {
  public:
-  CurveSink(const Affine& to_out, double arc_tolerance, std::string origin,
-            std::vector<Curve>* out)
+  CurveSink(const Affine& to_out, double arc_tolerance, std::string origin, std::vector<Curve>* out)
       : to_out_(to_out), arc_tolerance_(arc_tolerance), origin_(std::move(origin)), out_(out) {}
   void Line(const Vec2& from, const Vec2& to) override;
   void Cubic(const Vec2& p0, const Vec2& p1, const Vec2& p2, const Vec2& p3) override;

@@ -61,11 +61,11 @@ std::string Property(const pugi::xml_node& node, const char* name) {
 
 // What a group passes to its children.
 struct Context {
-  Affine to_out;              // user space → page, mm, y up
+  Affine to_out;                     // user space → page, mm, y up
   std::array<double, 2> viewport{};  // width, height in user units (percentages)
-  bool invisible = false;     // visibility:hidden (a child may say visible)
+  bool invisible = false;            // visibility:hidden (a child may say visible)
   std::string stroke = "none";
-  int layer = -1;             // Inkscape layer, -1 outside them
+  int layer = -1;  // Inkscape layer, -1 outside them
   int depth = 0;
 };
 
@@ -183,7 +183,11 @@ Affine Reader::ViewBox(const pugi::xml_node& node, double width, double height) 
     if (aspect.find("YMin") != std::string::npos) ay = 0;
     if (aspect.find("YMax") != std::string::npos) ay = 1;
   }
-  return {sx, 0, 0, sy, ax * (width - box[2] * sx) - box[0] * sx,
+  return {sx,
+          0,
+          0,
+          sy,
+          ax * (width - box[2] * sx) - box[0] * sx,
           ay * (height - box[3] * sy) - box[1] * sy};
 }
 
@@ -203,7 +207,12 @@ void Reader::SetPage(const pugi::xml_node& root, PatchSet* set, Context* context
   const bool has_box = root.attribute("viewBox");
   Affine user_to_mm{mm_per_px, 0, 0, mm_per_px, 0, 0};
   if (has_box) {
-    const std::vector<double> box = svg::ParseNumberList(root.attribute("viewBox").value());
+    std::vector<double> box;
+    try {
+      box = svg::ParseNumberList(root.attribute("viewBox").value());
+    } catch (const SyntaxError& e) {
+      throw Error(root, "viewBox", e.what());
+    }
     if (box.size() == 4 && box[2] > 0 && box[3] > 0) {
       if (width == 0 && height == 0) {
         width = box[2] * mm_per_px;
@@ -240,8 +249,7 @@ PatchSet Reader::Read() {
                      ": the root element is <" + root.name() + ">, not <svg>");
   }
   if (!(options_.arc_tolerance > 0)) {
-    throw OptionError("arc tolerance", FormatNumber(options_.arc_tolerance) + " mm",
-                      "must be > 0");
+    throw OptionError("arc tolerance", FormatNumber(options_.arc_tolerance) + " mm", "must be > 0");
   }
   CollectIds(doc);
   PatchSet set;
@@ -289,7 +297,8 @@ void Reader::Element(const pugi::xml_node& node, const Context& parent) {
   if (!stroke.empty() && stroke != "inherit") context.stroke = stroke;
   if (node.attribute("transform")) {
     try {
-      context.to_out = context.to_out.After(svg::ParseTransform(node.attribute("transform").value()));
+      context.to_out =
+          context.to_out.After(svg::ParseTransform(node.attribute("transform").value()));
     } catch (const SyntaxError& e) {
       throw Error(node, "transform", e.what());
     }
@@ -324,9 +333,8 @@ void Reader::Element(const pugi::xml_node& node, const Context& parent) {
     LeftOut("<style> sheet (CSS not applied)");
   } else if (kind == "symbol") {
     if (used_ids_.count(node.attribute("id").value()) == 0) LeftOut("unused <symbol>");
-  } else if (kind == "title" || kind == "desc" || kind == "metadata" ||
-             kind == "linearGradient" || kind == "radialGradient" || kind == "filter" ||
-             kind == "script") {
+  } else if (kind == "title" || kind == "desc" || kind == "metadata" || kind == "linearGradient" ||
+             kind == "radialGradient" || kind == "filter" || kind == "script") {
     // No geometry: nothing is lost.
   } else if (!Shape(kind, node, context)) {
     LeftOut("<" + kind + ">");
@@ -339,16 +347,19 @@ void Reader::Viewport(const pugi::xml_node& node, const pugi::xml_node& size_fro
                       Context context) {
   auto percent_or = [&](const char* attribute, double whole) {
     const std::string value = Trim(size_from.attribute(attribute).value());
-    if (value.empty() || value.back() == '%') {
-      const double fraction = value.empty() ? 1.0 : std::stod(value) / 100;
-      return whole * fraction;
+    if (value.empty()) return whole;
+    if (value.back() == '%') {
+      try {
+        return whole * svg::ParseLength(value.substr(0, value.size() - 1)) / 100;
+      } catch (const SyntaxError& e) {
+        throw Error(size_from, attribute, e.what());
+      }
     }
     return Length(size_from, attribute, whole);
   };
   // A <use> has already moved its symbol by its own x and y.
   if (node == size_from) {
-    context.to_out =
-        context.to_out.After({1, 0, 0, 1, Length(node, "x", 0), Length(node, "y", 0)});
+    context.to_out = context.to_out.After({1, 0, 0, 1, Length(node, "x", 0), Length(node, "y", 0)});
   }
   const double width = percent_or("width", context.viewport[0]);
   const double height = percent_or("height", context.viewport[1]);
@@ -376,13 +387,13 @@ void Reader::Use(const pugi::xml_node& node, Context context) {
     throw Error(node, attribute, "expected a reference to an element of this file, like #id");
   }
   const auto it = ids_.find(ref.substr(1));
-  if (it == ids_.end()) throw Error(node, attribute, "no element has the id '" + ref.substr(1) + "'");
+  if (it == ids_.end())
+    throw Error(node, attribute, "no element has the id '" + ref.substr(1) + "'");
   const pugi::xml_node target = it->second;
   if (std::find(use_stack_.begin(), use_stack_.end(), target) != use_stack_.end()) {
     throw Error(node, attribute, "refers to an element that contains this <use> (a cycle)");
   }
-  context.to_out =
-      context.to_out.After({1, 0, 0, 1, Length(node, "x", 0), Length(node, "y", 0)});
+  context.to_out = context.to_out.After({1, 0, 0, 1, Length(node, "x", 0), Length(node, "y", 0)});
   use_stack_.push_back(target);
   if (LocalName(target) == "symbol") {
     // Its own properties, then its viewport sized by the <use>.
@@ -403,10 +414,10 @@ void Reader::Draw(const pugi::xml_node& node, const Context& context, const char
     return;
   }
   std::vector<Curve> curves;
-  svg::CurveSink sink(context.to_out, options_.arc_tolerance,
-                      name_ + ": " + Describe(node) + " (line " +
-                          std::to_string(LineOf(node.offset_debug())) + ")",
-                      &curves);
+  svg::CurveSink sink(
+      context.to_out, options_.arc_tolerance,
+      name_ + ": " + Describe(node) + " (line " + std::to_string(LineOf(node.offset_debug())) + ")",
+      &curves);
   try {
     shape(&sink);
   } catch (const SyntaxError& e) {
@@ -509,8 +520,8 @@ bool Reader::Shape(const std::string& kind, const pugi::xml_node& node, const Co
     Draw(node, context, "", [&](svg::PathSink* sink) {
       // Four quarters from the rightmost point, in the positive angle
       // direction (clockwise on screen, as SVG 2 draws them).
-      const Vec2 points[5] = {{cx + rx, cy}, {cx, cy + ry}, {cx - rx, cy}, {cx, cy - ry},
-                              {cx + rx, cy}};
+      const Vec2 points[5] = {
+          {cx + rx, cy}, {cx, cy + ry}, {cx - rx, cy}, {cx, cy - ry}, {cx + rx, cy}};
       for (int i = 0; i < 4; ++i) sink->Arc(points[i], rx, ry, 0, false, true, points[i + 1]);
     });
   } else {
@@ -583,8 +594,8 @@ void SelectLayer(PatchSet* set, const std::string& spec) {
   for (std::size_t i = 0; i < set->layers.size(); ++i) {
     if (set->layers[i] == spec) chosen = static_cast<int>(i);
   }
-  if (chosen < 0 && !spec.empty() &&
-      spec.find_first_not_of("0123456789") == std::string::npos && spec.size() < 6) {
+  if (chosen < 0 && !spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos &&
+      spec.size() < 6) {
     const int number = std::stoi(spec);
     if (number >= 1 && number <= static_cast<int>(set->layers.size())) chosen = number - 1;
   }

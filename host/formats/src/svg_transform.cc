@@ -13,9 +13,8 @@
 namespace fdsurf::host::svg {
 
 Affine Affine::After(const Affine& inner) const {
-  return {a * inner.a + c * inner.b,     b * inner.a + d * inner.b,
-          a * inner.c + c * inner.d,     b * inner.c + d * inner.d,
-          a * inner.e + c * inner.f + e, b * inner.e + d * inner.f + f};
+  return {a * inner.a + c * inner.b, b * inner.a + d * inner.b,     a * inner.c + c * inner.d,
+          b * inner.c + d * inner.d, a * inner.e + c * inner.f + e, b * inner.e + d * inner.f + f};
 }
 
 double Affine::MaxStretch() const {
