@@ -25,7 +25,7 @@ using svg::Vec2;
 // The element's name without an "svg:" prefix; "" for another namespace's
 // element (inkscape:, sodipodi:), which draws nothing.
 std::string LocalName(const pugi::xml_node& node) {
-  const std::string name = node.name();
+  std::string name = node.name();
   const std::size_t colon = name.find(':');
   if (colon == std::string::npos) return name;
   return name.substr(0, colon) == "svg" ? name.substr(colon + 1) : std::string();
@@ -81,7 +81,7 @@ class Reader {
   PatchSet Read();
 
  private:
-  int LineOf(std::ptrdiff_t offset) const {
+  FDSURF_NODISCARD int LineOf(std::ptrdiff_t offset) const {
     if (offset < 0) return 0;
     const auto it = std::upper_bound(line_starts_.begin(), line_starts_.end(),
                                      static_cast<std::size_t>(offset));
@@ -93,12 +93,13 @@ class Reader {
     if (*id != '\0') s += std::string(" id=\"") + id + "\"";
     return s + ">";
   }
-  InputError Error(const pugi::xml_node& node, const std::string& attribute,
-                   const std::string& what) const {
+  FDSURF_NODISCARD InputError Error(const pugi::xml_node& node, const std::string& attribute,
+                                    const std::string& what) const {
     return InputError(name_ + ":" + std::to_string(LineOf(node.offset_debug())) + ": " +
                       Describe(node) + (attribute.empty() ? "" : " " + attribute) + ": " + what);
   }
-  double Length(const pugi::xml_node& node, const char* attribute, double fallback) const {
+  FDSURF_NODISCARD double Length(const pugi::xml_node& node, const char* attribute,
+                                 double fallback) const {
     const pugi::xml_attribute a = node.attribute(attribute);
     if (!a) return fallback;
     try {
@@ -118,10 +119,13 @@ class Reader {
   }
 
   void SetPage(const pugi::xml_node& root, PatchSet* set, Context* context);
-  Affine ViewBox(const pugi::xml_node& node, double width, double height) const;
+  FDSURF_NODISCARD Affine ViewBox(const pugi::xml_node& node, double width, double height) const;
   void Walk(const pugi::xml_node& parent, const Context& context);
-  void Element(const pugi::xml_node& node, const Context& context);
+  void Element(const pugi::xml_node& node, const Context& parent);
   bool Shape(const std::string& kind, const pugi::xml_node& node, const Context& context);
+  void Rect(const pugi::xml_node& node, const Context& context);
+  void Oval(const std::string& kind, const pugi::xml_node& node, const Context& context);
+  FDSURF_NODISCARD double NonNegative(const pugi::xml_node& node, const char* attribute) const;
   void Use(const pugi::xml_node& node, Context context);
   void Viewport(const pugi::xml_node& node, const pugi::xml_node& size_from, Context context);
   void Draw(const pugi::xml_node& node, const Context& context, const char* attribute,
@@ -443,11 +447,6 @@ void Reader::Draw(const pugi::xml_node& node, const Context& context, const char
 // auto rule and clamping; circle; ellipse; line; polyline; polygon) and
 // <path>. False for an element that is none of them.
 bool Reader::Shape(const std::string& kind, const pugi::xml_node& node, const Context& context) {
-  auto non_negative = [&](const char* attribute) {
-    const double v = Length(node, attribute, 0);
-    if (v < 0) throw Error(node, attribute, "must not be negative");
-    return v;
-  };
   if (kind == "path") {
     const std::string d = node.attribute("d").value();
     Draw(node, context, "d", [&](svg::PathSink* sink) { svg::ParsePathData(d, sink); });
@@ -472,62 +471,79 @@ bool Reader::Shape(const std::string& kind, const pugi::xml_node& node, const Co
       }
     });
   } else if (kind == "rect") {
-    const double x = Length(node, "x", 0);
-    const double y = Length(node, "y", 0);
-    const double w = non_negative("width");
-    const double h = non_negative("height");
-    const bool auto_rx = !node.attribute("rx") || Trim(node.attribute("rx").value()) == "auto";
-    const bool auto_ry = !node.attribute("ry") || Trim(node.attribute("ry").value()) == "auto";
-    double rx = auto_rx ? 0 : non_negative("rx");
-    double ry = auto_ry ? 0 : non_negative("ry");
-    if (auto_rx) rx = ry;
-    if (auto_ry) ry = rx;
-    rx = std::min(rx, w / 2);
-    ry = std::min(ry, h / 2);
-    if (w == 0 || h == 0) return true;  // SVG 2: not rendered
-    Draw(node, context, "", [&](svg::PathSink* sink) {
-      const bool round = rx > 0 && ry > 0;
-      const Vec2 corners[4][2] = {{{x + w - rx, y}, {x + w, y + ry}},
-                                  {{x + w, y + h - ry}, {x + w - rx, y + h}},
-                                  {{x + rx, y + h}, {x, y + h - ry}},
-                                  {{x, y + ry}, {x + rx, y}}};
-      for (int i = 0; i < 4; ++i) {
-        const Vec2& edge_start = corners[(i + 3) % 4][1];
-        if (round) {
-          if (edge_start != corners[i][0]) sink->Line(edge_start, corners[i][0]);
-          sink->Arc(corners[i][0], rx, ry, 0, false, true, corners[i][1]);
-        } else {
-          sink->Line(corners[(i + 3) % 4][0], corners[i][0]);
-        }
-      }
-    });
+    Rect(node, context);
   } else if (kind == "circle" || kind == "ellipse") {
-    const double cx = Length(node, "cx", 0);
-    const double cy = Length(node, "cy", 0);
-    double rx = 0;
-    double ry = 0;
-    if (kind == "circle") {
-      rx = ry = non_negative("r");
-    } else {
-      const bool auto_rx = !node.attribute("rx") || Trim(node.attribute("rx").value()) == "auto";
-      const bool auto_ry = !node.attribute("ry") || Trim(node.attribute("ry").value()) == "auto";
-      rx = auto_rx ? 0 : non_negative("rx");
-      ry = auto_ry ? 0 : non_negative("ry");
-      if (auto_rx) rx = ry;
-      if (auto_ry) ry = rx;
-    }
-    if (rx == 0 || ry == 0) return true;  // SVG 2: not rendered
-    Draw(node, context, "", [&](svg::PathSink* sink) {
-      // Four quarters from the rightmost point, in the positive angle
-      // direction (clockwise on screen, as SVG 2 draws them).
-      const Vec2 points[5] = {
-          {cx + rx, cy}, {cx, cy + ry}, {cx - rx, cy}, {cx, cy - ry}, {cx + rx, cy}};
-      for (int i = 0; i < 4; ++i) sink->Arc(points[i], rx, ry, 0, false, true, points[i + 1]);
-    });
+    Oval(kind, node, context);
   } else {
     return false;
   }
   return true;
+}
+
+double Reader::NonNegative(const pugi::xml_node& node, const char* attribute) const {
+  const double v = Length(node, attribute, 0);
+  if (v < 0) throw Error(node, attribute, "must not be negative");
+  return v;
+}
+
+// <rect>: four edges, and with rx, ry four quarter arcs clockwise on the
+// screen from the top edge (SVG 2's order).
+void Reader::Rect(const pugi::xml_node& node, const Context& context) {
+  const double x = Length(node, "x", 0);
+  const double y = Length(node, "y", 0);
+  const double w = NonNegative(node, "width");
+  const double h = NonNegative(node, "height");
+  const bool auto_rx = !node.attribute("rx") || Trim(node.attribute("rx").value()) == "auto";
+  const bool auto_ry = !node.attribute("ry") || Trim(node.attribute("ry").value()) == "auto";
+  double rx = auto_rx ? 0 : NonNegative(node, "rx");
+  double ry = auto_ry ? 0 : NonNegative(node, "ry");
+  if (auto_rx) rx = ry;
+  if (auto_ry) ry = rx;
+  rx = std::min(rx, w / 2);
+  ry = std::min(ry, h / 2);
+  if (w == 0 || h == 0) return;  // SVG 2: not rendered
+  Draw(node, context, "", [&](svg::PathSink* sink) {
+    const bool round = rx > 0 && ry > 0;
+    const Vec2 corners[4][2] = {{{x + w - rx, y}, {x + w, y + ry}},
+                                {{x + w, y + h - ry}, {x + w - rx, y + h}},
+                                {{x + rx, y + h}, {x, y + h - ry}},
+                                {{x, y + ry}, {x + rx, y}}};
+    for (int i = 0; i < 4; ++i) {
+      const Vec2& edge_start = corners[(i + 3) % 4][1];
+      if (round) {
+        if (edge_start != corners[i][0]) sink->Line(edge_start, corners[i][0]);
+        sink->Arc(corners[i][0], rx, ry, 0, false, true, corners[i][1]);
+      } else {
+        sink->Line(corners[(i + 3) % 4][0], corners[i][0]);
+      }
+    }
+  });
+}
+
+// <circle>, <ellipse>: four quarter arcs.
+void Reader::Oval(const std::string& kind, const pugi::xml_node& node, const Context& context) {
+  const double cx = Length(node, "cx", 0);
+  const double cy = Length(node, "cy", 0);
+  double rx = 0;
+  double ry = 0;
+  if (kind == "circle") {
+    rx = ry = NonNegative(node, "r");
+  } else {
+    const bool auto_rx = !node.attribute("rx") || Trim(node.attribute("rx").value()) == "auto";
+    const bool auto_ry = !node.attribute("ry") || Trim(node.attribute("ry").value()) == "auto";
+    rx = auto_rx ? 0 : NonNegative(node, "rx");
+    ry = auto_ry ? 0 : NonNegative(node, "ry");
+    if (auto_rx) rx = ry;
+    if (auto_ry) ry = rx;
+  }
+  if (rx == 0 || ry == 0) return;  // SVG 2: not rendered
+  Draw(node, context, "", [&](svg::PathSink* sink) {
+    // Four quarters from the rightmost point, in the positive angle
+    // direction (clockwise on screen, as SVG 2 draws them).
+    const Vec2 points[5] = {
+        {cx + rx, cy}, {cx, cy + ry}, {cx - rx, cy}, {cx, cy - ry}, {cx + rx, cy}};
+    for (int i = 0; i < 4; ++i) sink->Arc(points[i], rx, ry, 0, false, true, points[i + 1]);
+  });
 }
 
 // Inkscape layers when there are any (curves outside them get a layer of
