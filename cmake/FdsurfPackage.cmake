@@ -23,7 +23,7 @@ Samples, checks, plots (SVG, G-code, HPGL, PNG) and streams patch files to a plo
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME fdsurf-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 # Static libraries: what their users link against.
-set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libcairo2-dev, pkg-config")
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "libcairo2-dev, libpugixml-dev, pkg-config")
 set(CPACK_DEBIAN_DEV_PACKAGE_SUGGESTS "libusb-1.0-0-dev, libgpiod-dev, libserialport-dev")
 set(CPACK_COMPONENT_DEV_DESCRIPTION
     "fdsurf static libraries and headers\n\

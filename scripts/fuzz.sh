@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
-targets=${FDSURF_FUZZ_TARGETS:-fuzz_bpt fuzz_json fuzz_mesh fuzz_gcode fuzz_device_bytes fuzz_device_frames}
+targets=${FDSURF_FUZZ_TARGETS:-fuzz_bpt fuzz_json fuzz_mesh fuzz_gcode fuzz_svg fuzz_device_bytes fuzz_device_frames}
 jobs=${FDSURF_FUZZ_JOBS:-1}
 build=build-fuzz
 
@@ -25,7 +25,7 @@ build=build-fuzz
 # triangles, a few frames' worth of link bytes, a few dozen host actions.
 max_len() {
   case $1 in
-    fuzz_bpt | fuzz_json | fuzz_mesh | fuzz_gcode) echo 4096 ;;
+    fuzz_bpt | fuzz_json | fuzz_mesh | fuzz_gcode | fuzz_svg) echo 4096 ;;
     fuzz_device_bytes) echo 2048 ;;
     fuzz_device_frames) echo 1024 ;;
   esac

@@ -17,6 +17,8 @@
 
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/patch_io.h"
+#include "fdsurf/host/svg_io.h"
 
 namespace fdsurf::host {
 
@@ -47,8 +49,9 @@ Grid ParseGrid(const std::string& text) {
 void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format) {
   command
       ->add_option("FILE", *file,
-                   "drawing: patches (.bpt, .json) or a triangle mesh (.obj, .ply); - reads "
-                   "standard input; see docs/formats.md")
+                   "drawing: patches (.bpt, .json), an SVG drawing (.svg), a G-code program "
+                   "(.gcode, .nc, .ngc) or a triangle mesh (.obj, .ply); - reads standard "
+                   "input; see docs/formats.md")
       ->required();
   command
       ->add_option("--input-format", *input_format,
@@ -265,6 +268,29 @@ void StagedOutputs::Commit() {
     }
   }
   staged_.clear();
+}
+
+PatchSet ReadDrawing(const std::string& file, const std::string& input_format,
+                     const std::string& layer, bool quiet) {
+  PatchSet set = ReadPatchFile(file, input_format);
+  if (!layer.empty()) SelectLayer(&set, layer);
+  if (!quiet) {
+    for (const std::string& note : set.notes) {
+      if (note.find(": left out: ") != std::string::npos) {
+        std::fprintf(stderr, "fdsurf: note: %s\n", note.c_str());
+      }
+    }
+  }
+  return set;
+}
+
+bool IsFlatDrawing(const PatchSet& set) {
+  if (!set.patches.empty() || set.curves.empty()) return false;
+  // A page (SVG) or a program (G-code, whose Z is the pen) is drawn in plan.
+  if (set.page || set.keep_order) return true;
+  return std::all_of(set.curves.begin(), set.curves.end(), [](const Curve& curve) {
+    return std::all_of(curve.g.begin(), curve.g.end(), [](const Point3& p) { return p[2] == 0; });
+  });
 }
 
 bool ShowProgress(bool quiet) {

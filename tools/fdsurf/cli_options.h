@@ -87,6 +87,18 @@ View ParseView(const std::string& text);
 /// "tolerance" is --tolerance, "pen delay" --pen-delay, "travel X" --travel X.
 std::string FlagFor(const std::string& field);
 
+/// The drawing of `plot`, `render` and `stream`: ReadPatchFile (with
+/// --input-format when given), then only the layer `layer` names when it is
+/// not empty (--layer NAME|N, SelectLayer); the reader's "left out: ..."
+/// notes go to stderr unless `quiet`. Throws InputError as those do.
+PatchSet ReadDrawing(const std::string& file, const std::string& input_format,
+                     const std::string& layer, bool quiet);
+
+/// A drawing in the xy plane (no patches; a page of its own (SVG), a program
+/// (G-code, whose Z is the pen) or every curve at z = 0): drawn from the top
+/// unless --view says otherwise.
+bool IsFlatDrawing(const PatchSet& set);
+
 /// Whether to draw a progress line: stderr is a terminal, not quiet, not CI.
 bool ShowProgress(bool quiet);
 

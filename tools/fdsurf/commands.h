@@ -35,8 +35,9 @@ struct PlotOptions {
   int png_width = 1600;
   std::string tolerance;
   std::string lines = "8";
-  std::string view = "iso";
+  std::string view;  // empty: iso, or top for a flat drawing (IsFlatDrawing)
   std::string units = "mm";
+  std::string layer;  // --layer NAME|N, empty: all
   std::string fit;
   std::string origin;
   std::string margin;

@@ -101,7 +101,7 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
   t.lines_t = lines[1];
-  t.view = ParseView(o.view);
+  t.view = ParseView(o.view.empty() ? "iso" : o.view);
   // Checked before the file is read; PlacePage sets the page after.
   if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
   if (!o.origin.empty()) (void)ParseOrigin(o.origin);
@@ -233,7 +233,8 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   const std::string format = OutputFormat(o, render_only);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadPatchFile(options.file, o.input_format);
+  const PatchSet set = ReadDrawing(options.file, o.input_format, o.layer, o.quiet);
+  if (o.view.empty() && IsFlatDrawing(set)) t.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
   PlacePage(o.fit, o.origin, o.units, ToWork(o, format), set, &t);
@@ -298,8 +299,10 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
       ->capture_default_str();
-  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")
-      ->capture_default_str();
+  command->add_option("--view", o->view,
+                      "top, front, side, iso or AZ,EL (degrees); default iso, top for a flat "
+                      "drawing (SVG)");
+  command->add_option("--layer", o->layer, "draw only this layer: its name or number (1, 2, ...)");
   command->add_option("--units", o->units, "units of the output and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();

@@ -22,7 +22,7 @@ ToolpathOptions DrawingOptions(const StreamOptions& o) {
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
   t.lines_t = lines[1];
-  t.view = ParseView(o.view);
+  t.view = ParseView(o.view.empty() ? "iso" : o.view);
   // Checked before the file is read; PlacePage sets the page after.
   if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
   if (!o.origin.empty()) (void)ParseOrigin(o.origin);
@@ -90,8 +90,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
       ->capture_default_str();
-  command->add_option("--view", o->view, "top, front, side, iso or AZ,EL (degrees)")
-      ->capture_default_str();
+  command->add_option("--view", o->view,
+                      "top, front, side, iso or AZ,EL (degrees); default iso, top for a flat "
+                      "drawing (SVG)");
+  command->add_option("--layer", o->layer, "draw only this layer: its name or number (1, 2, ...)");
   command->add_option("--units", o->units, "units of the drawing and of these options")
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
@@ -183,9 +185,10 @@ int RunStream(const StreamOptions& options) {
   if (sim && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000");
   }
-  const ToolpathOptions drawing = DrawingOptions(o);
+  ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadPatchFile(options.file, o.input_format);
+  const PatchSet set = ReadDrawing(options.file, o.input_format, o.layer, o.quiet);
+  if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);

@@ -18,7 +18,8 @@ struct StreamOptions {
   std::string device = "sim";
   // The drawing, as for `fdsurf plot`.
   std::string lines = "8";
-  std::string view = "iso";
+  std::string view;   // empty: iso, or top for a flat drawing (IsFlatDrawing)
+  std::string layer;  // --layer NAME|N, empty: all
   std::string units = "mm";
   /// --fit and --origin as typed, "" when left out (PlacePage's defaults).
   std::string fit;

@@ -14,6 +14,7 @@
 
 #include "construct_io.h"
 #include "fdsurf/host/gcode_io.h"
+#include "fdsurf/host/svg_io.h"
 
 namespace fdsurf::host {
 namespace {
@@ -318,6 +319,11 @@ PatchSet ParsePlyMesh(const std::string& bytes, const std::string& name) {
   return MeshAsPatchSet(ParsePly(bytes, name), name);
 }
 
+// An SVG drawing with the reader's default arc tolerance (svg_io.h).
+PatchSet ReadSvgDrawing(const std::string& text, const std::string& name) {
+  return ReadSvg(text, name);
+}
+
 // A G-code program with the reader's default conventions (gcode_io.h).
 PatchSet ReadGcodeProgram(const std::string& text, const std::string& name) {
   return ReadGcode(text, name);
@@ -337,7 +343,7 @@ constexpr InputFormat kInputFormats[] = {
     {"json", {".json"}, ParseJson},
     {"obj", {".obj"}, ParseObjMesh},
     {"ply", {".ply"}, ParsePlyMesh},
-    {"svg", {".svg"}, nullptr},
+    {"svg", {".svg"}, ReadSvgDrawing},
     {"gcode", {".gcode", ".nc", ".ngc", ".g", ".gco"}, ReadGcodeProgram},
 };
 
