@@ -10,8 +10,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
-  # The SVG reader (libpugixml-dev); its third-party checks (inkscape).
-  libpugixml-dev inkscape
+  # The SVG reader.
+  libpugixml-dev
   clang-format clang-tidy
   # The libFuzzer targets (scripts/fuzz.sh): clang and its runtimes
   # (libclang_rt.fuzzer and the sanitizers are in libclang-rt-14-dev).

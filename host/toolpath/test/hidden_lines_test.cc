@@ -461,7 +461,8 @@ TEST(HiddenLines, CutPiecesKeepTheCubicOfTheirOwnStretch) {
         for (std::size_t i = 0; i < 4; ++i) on_cubic[k] += w[i] * b[i][k];
       }
       const Vec exact = ExactWithDepth(set, d.after, s, a + u * (e - a));
-      EXPECT_LT(PlaneDistance(on_cubic, exact), 1e-9) << "piece of patch " << s.patch << " at " << u;
+      EXPECT_LT(PlaneDistance(on_cubic, exact), 1e-9)
+          << "piece of patch " << s.patch << " at " << u;
     }
   }
   EXPECT_GT(cut, 50u);
