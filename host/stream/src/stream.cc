@@ -238,14 +238,14 @@ std::vector<CurveVisit> OrderLayer(const std::vector<std::size_t>& curves,
                      static_cast<double>(p[2])};
   };
   std::vector<std::array<PlanPoint, 2>> ends;
+  ends.reserve(chains.size());
   for (const auto& chain : chains) {
     ends.push_back({point(device[chain.front()].start), point(device[chain.back()].end)});
   }
   for (const Visit& visit : OrderNearestNeighbour(ends, reversible, PlanMetric::kSpace, from)) {
     const auto& chain = chains[visit.index];
     if (visit.reversed) {
-      for (auto it = chain.rbegin(); it != chain.rend(); ++it)
-        order.push_back(CurveVisit{*it, true});
+      for (std::size_t k = chain.size(); k-- > 0;) order.push_back(CurveVisit{chain[k], true});
     } else {
       for (const std::size_t c : chain) order.push_back(CurveVisit{c, false});
     }

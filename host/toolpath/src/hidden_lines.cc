@@ -151,11 +151,8 @@ std::array<std::array<double, 3>, 4> SubCubic(const std::array<std::array<double
     for (int level = 0; level < 4; ++level) {
       first[static_cast<std::size_t>(level)] = w[0];
       second[static_cast<std::size_t>(3 - level)] = w[static_cast<std::size_t>(3 - level)];
-      for (int i = 0; i + level < 3; ++i) {
-        for (int k = 0; k < 3; ++k) {
-          auto& wi = w[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)];
-          wi += t * (w[static_cast<std::size_t>(i + 1)][static_cast<std::size_t>(k)] - wi);
-        }
+      for (std::size_t i = 0; i + static_cast<std::size_t>(level) < 3; ++i) {
+        for (std::size_t k = 0; k < 3; ++k) w[i][k] += t * (w[i + 1][k] - w[i][k]);
       }
     }
     return keep_first ? first : second;
