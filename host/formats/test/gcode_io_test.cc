@@ -12,20 +12,15 @@
 
 #include "fdsurf/host/gcode_io.h"
 #include "fdsurf/host/patch_io.h"
+#include "format_test_support.h"
 
 namespace fdsurf::host {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using format_test::BezierAt;
+using format_test::ErrorOf;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+constexpr double kPi = std::numbers::pi;
 
 PatchSet Read(const std::string& text, const GcodeReadOptions& options = {}) {
   return ReadGcode(text, "p.gcode", options);
@@ -35,16 +30,6 @@ std::string ReadError(const std::string& text) {
   return ErrorOf([&] { (void)Read(text); });
 }
 
-Point3 Bezier(const Curve& c, double t) {
-  const double u = 1 - t;
-  const double b[4] = {u * u * u, 3 * u * u * t, 3 * u * t * t, t * t * t};
-  Point3 p{0, 0, 0};
-  for (int i = 0; i < 4; ++i) {
-    for (int k = 0; k < 3; ++k) p[k] += b[i] * c.g[i][k];
-  }
-  return p;
-}
-
 void ExpectPoint(const Point3& got, const Point3& want, double tolerance, const std::string& what) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], tolerance) << what << " axis " << k;
 }
@@ -52,10 +37,11 @@ void ExpectPoint(const Point3& got, const Point3& want, double tolerance, const 
 void ExpectLine(const Curve& c, const Point3& from, const Point3& to) {
   EXPECT_TRUE(c.straight) << c.origin;
   EXPECT_EQ(c.basis, Basis::kBezier);
-  ExpectPoint(Bezier(c, 0), from, 1e-12, c.origin + " start");
-  ExpectPoint(Bezier(c, 1), to, 1e-12, c.origin + " end");
-  ExpectPoint(Bezier(c, 0.5), {(from[0] + to[0]) / 2, (from[1] + to[1]) / 2, (from[2] + to[2]) / 2},
-              1e-12, c.origin + " middle");
+  ExpectPoint(BezierAt(c, 0), from, 1e-12, c.origin + " start");
+  ExpectPoint(BezierAt(c, 1), to, 1e-12, c.origin + " end");
+  ExpectPoint(BezierAt(c, 0.5),
+              {(from[0] + to[0]) / 2, (from[1] + to[1]) / 2, (from[2] + to[2]) / 2}, 1e-12,
+              c.origin + " middle");
 }
 
 // The plane of an arc: the axes a, b (angles turn from a to b) and normal n.
@@ -77,21 +63,21 @@ void ExpectArc(const PatchSet& set, std::size_t first, std::size_t last, Plane p
   const auto angle_of = [&](const Point3& q) {
     return std::atan2(q[p.b] - centre[1], q[p.a] - centre[0]);
   };
-  const Point3 start = Bezier(set.curves[first], 0);
+  const Point3 start = BezierAt(set.curves[first], 0);
   EXPECT_NEAR(start[p.a], centre[0] + r * std::cos(a0), 1e-9);
   EXPECT_NEAR(start[p.b], centre[1] + r * std::sin(a0), 1e-9);
-  const Point3 end = Bezier(set.curves[last - 1], 1);
+  const Point3 end = BezierAt(set.curves[last - 1], 1);
   EXPECT_NEAR(end[p.a], centre[0] + r * std::cos(a0 + sweep), 1e-9);
   EXPECT_NEAR(end[p.b], centre[1] + r * std::sin(a0 + sweep), 1e-9);
   double turned = 0;
   double previous = angle_of(start);
   for (std::size_t c = first; c < last; ++c) {
     if (c > first) {
-      ExpectPoint(Bezier(set.curves[c], 0), Bezier(set.curves[c - 1], 1), 1e-12, "join");
+      ExpectPoint(BezierAt(set.curves[c], 0), BezierAt(set.curves[c - 1], 1), 1e-12, "join");
     }
     EXPECT_FALSE(set.curves[c].straight);
     for (int k = 1; k <= 64; ++k) {
-      const Point3 q = Bezier(set.curves[c], k / 64.0);
+      const Point3 q = BezierAt(set.curves[c], k / 64.0);
       const double distance = std::hypot(q[p.a] - centre[0], q[p.b] - centre[1]);
       EXPECT_NEAR(distance, r, bound + 1e-12) << set.curves[c].origin << " t=" << k / 64.0;
       double step = angle_of(q) - previous;
@@ -336,7 +322,7 @@ TEST(GcodeArcs, HelixMovesTheNormalAxisAlong) {
   options.pen_z_threshold = 100;
   const PatchSet set = Read("G0 X4 Y0 Z0\nG3 X-4 Y0 Z-2 I-4 J0\n", options);
   ExpectArc(set, 0, set.curves.size(), kXY, {0, 0}, 4, 0, kPi);
-  EXPECT_NEAR(Bezier(set.curves.back(), 1)[2], -2, 1e-12);
+  EXPECT_NEAR(BezierAt(set.curves.back(), 1)[2], -2, 1e-12);
   EXPECT_EQ(CountNotes(set, "p.gcode:2: G3: a helical move"), 1u);
 }
 
@@ -406,7 +392,7 @@ TEST(GcodeSplines, QuadraticIsRaisedExactly) {
     const double u = 1 - t;
     const Point3 want = {u * u * 1 + 2 * t * u * 4 + t * t * 7,
                          u * u * 1 + 2 * t * u * 7 + t * t * 1, 0};
-    ExpectPoint(Bezier(set.curves[0], t), want, 1e-13, "t=" + std::to_string(t));
+    ExpectPoint(BezierAt(set.curves[0], t), want, 1e-13, "t=" + std::to_string(t));
   }
   EXPECT_EQ(ReadError("G5.1 X1 Y1\n"), "p.gcode:1: G5.1: I and J are both zero or missing");
 }

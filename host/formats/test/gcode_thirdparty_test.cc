@@ -18,9 +18,12 @@
 #include <sstream>
 
 #include "fdsurf/host/gcode_io.h"
+#include "format_test_support.h"
 
 namespace fdsurf::host {
 namespace {
+
+using format_test::BezierAt;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -34,16 +37,6 @@ std::string Slurp(const std::string& path) {
 std::string Dir() {
   const char* dir = std::getenv("FDSURF_LINUXCNC_NCFILES");
   return dir == nullptr ? "" : dir;
-}
-
-Point3 Bezier(const Curve& c, double t) {
-  const double u = 1 - t;
-  const double b[4] = {u * u * u, 3 * u * u * t, 3 * u * t * t, t * t * t};
-  Point3 p{0, 0, 0};
-  for (int i = 0; i < 4; ++i) {
-    for (int k = 0; k < 3; ++k) p[k] += b[i] * c.g[i][k];
-  }
-  return p;
 }
 
 double Wrap(double degrees) {
@@ -97,8 +90,8 @@ TEST(GcodeThirdParty, LinuxCncTortureArcsMatchTheirStatedAngles) {
     const char letters[3] = {'I', 'J', 'K'};
     const auto& curves = by_line[number];
     ASSERT_FALSE(curves.empty()) << "line " << number;
-    const Point3 start = Bezier(*curves.front(), 0);
-    const Point3 end = Bezier(*curves.back(), 1);
+    const Point3 start = BezierAt(*curves.front(), 0);
+    const Point3 end = BezierAt(*curves.back(), 1);
     const double ca = start[a] + offsets[letters[a]];
     const double cb = start[b] + offsets[letters[b]];
     const double radius = std::hypot(offsets[letters[a]], offsets[letters[b]]);
@@ -120,7 +113,7 @@ TEST(GcodeThirdParty, LinuxCncTortureArcsMatchTheirStatedAngles) {
     double previous = angle(start);
     for (const Curve* c : curves) {
       for (int k = 1; k <= 32; ++k) {
-        const Point3 q = Bezier(*c, k / 32.0);
+        const Point3 q = BezierAt(*c, k / 32.0);
         EXPECT_NEAR(std::hypot(q[a] - ca, q[b] - cb), radius, 1e-5) << "line " << number;
         double step = angle(q) - previous;
         if (step > 180) step -= 360;

@@ -12,18 +12,12 @@
 
 #include "fdsurf/host/mesh_io.h"
 #include "fdsurf/host/vec3.h"
+#include "format_test_support.h"
 
 namespace fdsurf::host {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using format_test::ErrorOf;
 
 void ExpectNear(const Point3& got, const Point3& want, double tolerance, const std::string& what) {
   for (int k = 0; k < 3; ++k) {

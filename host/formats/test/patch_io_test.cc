@@ -4,9 +4,12 @@
 
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/quantum.h"
+#include "format_test_support.h"
 
 namespace fdsurf::host {
 namespace {
+
+using format_test::ErrorOf;
 
 // A string of `count` BPT patches whose control point (i,j) is (i, j, p).
 std::string BptText(int count) {
@@ -20,15 +23,6 @@ std::string BptText(int count) {
     }
   }
   return text;
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 TEST(Bpt, ReadsTheTeapot) {

@@ -15,9 +15,13 @@
 #include <numbers>
 
 #include "fdsurf/host/patch_io.h"
+#include "format_test_support.h"
 
 namespace fdsurf::host {
 namespace {
+
+using format_test::BezierAt;
+using format_test::ErrorOf;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -31,17 +35,6 @@ std::string Page(const std::string& body, const std::string& extra = "") {
 
 PatchSet Read(const std::string& body, const SvgOptions& options = {}) {
   return ReadSvg(Page(body), "t.svg", options);
-}
-
-// The Bézier curve at u, from the Bernstein form (independent of the reader).
-Point3 At(const Curve& c, double u) {
-  const double v = 1 - u;
-  const double b[4] = {v * v * v, 3 * u * v * v, 3 * u * u * v, u * u * u};
-  Point3 p{};
-  for (int i = 0; i < 4; ++i) {
-    for (int k = 0; k < 3; ++k) p[k] += b[i] * c.g[i][k];
-  }
-  return p;
 }
 
 // Output point of an SVG user point on the test page.
@@ -58,17 +51,8 @@ void ExpectLine(const Curve& c, const Point3& a, const Point3& b) {
   EXPECT_TRUE(c.straight);
   EXPECT_EQ(c.basis, Basis::kBezier);
   for (double u : {0.0, 0.25, 0.5, 1.0}) {
-    ExpectNear(At(c, u), {a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), 0});
+    ExpectNear(BezierAt(c, u), {a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]), 0});
   }
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 // ---- the path grammar -------------------------------------------------------
@@ -98,7 +82,7 @@ TEST(SvgPath, CubicsAreExactAndSReflects) {
   const Curve& c = set.curves[0];
   EXPECT_FALSE(c.straight);
   // The cubic at u = 1/2 by hand: (0 + 3·10 + 3·20 + 20)/8, (0 + 0 + 3·10 + 20)/8.
-  ExpectNear(At(c, 0.5), Out(110.0 / 8, 50.0 / 8));
+  ExpectNear(BezierAt(c, 0.5), Out(110.0 / 8, 50.0 / 8));
   // s: first control = (20,20) reflected (20,10) = (20,30); others relative to (20,20).
   ExpectNear(set.curves[1].g[1], Out(20, 30));
   ExpectNear(set.curves[1].g[2], Out(30, 40));
@@ -121,11 +105,11 @@ TEST(SvgPath, QuadraticsAreDegreeElevatedExactly) {
     const double a = (1 - u) * (1 - u);
     const double b = 2 * u * (1 - u);
     const double e = u * u;
-    ExpectNear(At(set.curves[0], u), Out(b * 30 + e * 30, e * 30));
+    ExpectNear(BezierAt(set.curves[0], u), Out(b * 30 + e * 30, e * 30));
     // T: control (30,30) reflected (30,0) = (30,60), from (30,30) to (60,60).
-    ExpectNear(At(set.curves[1], u), Out(a * 30 + b * 30 + e * 60, a * 30 + b * 60 + e * 60));
+    ExpectNear(BezierAt(set.curves[1], u), Out(a * 30 + b * 30 + e * 60, a * 30 + b * 60 + e * 60));
     // t: control (60,60) reflected (30,60) = (90,60), to (60,90).
-    ExpectNear(At(set.curves[2], u), Out(a * 60 + b * 90 + e * 60, a * 60 + b * 60 + e * 90));
+    ExpectNear(BezierAt(set.curves[2], u), Out(a * 60 + b * 90 + e * 60, a * 60 + b * 60 + e * 90));
   }
 }
 
@@ -147,7 +131,7 @@ TEST(SvgPath, ArcFlagsWithoutSeparators) {
     ExpectNear(set.curves.back().g[3], Out(10, 10));
     for (const Curve& c : set.curves) {
       for (double u = 0; u <= 1; u += 0.125) {
-        const Point3 p = At(c, u);
+        const Point3 p = BezierAt(c, u);
         EXPECT_NEAR(std::hypot(p[0] - 0, p[1] - 90), 10, 1e-6) << d;
       }
     }
@@ -175,13 +159,13 @@ TEST(SvgPath, TooSmallRadiiAreScaledUp) {
   ASSERT_FALSE(set.curves.empty());
   for (const Curve& c : set.curves) {
     for (double u = 0; u <= 1; u += 0.25) {
-      const Point3 p = At(c, u);
+      const Point3 p = BezierAt(c, u);
       EXPECT_NEAR(std::hypot(p[0] - 10, p[1] - 50), 10, 1e-6);
     }
   }
   // Sweep 1 from the left end: through the top of the screen (SVG y = 40).
   bool reaches_top = false;
-  for (const Curve& c : set.curves) reaches_top |= std::abs(At(c, 1)[1] - 60) < 1e-9;
+  for (const Curve& c : set.curves) reaches_top |= std::abs(BezierAt(c, 1)[1] - 60) < 1e-9;
   EXPECT_TRUE(reaches_top);
 }
 
@@ -227,7 +211,7 @@ TEST(SvgShapes, RectSquareAndRounded) {
     EXPECT_EQ(straight, 2) << rect;
     // Every point of the top-left corner is 15 from its centre (25, 35).
     for (const Curve& c : round.curves) {
-      const Point3 p = At(c, 0.5);
+      const Point3 p = BezierAt(c, 0.5);
       if (!c.straight && p[0] < 25 && p[1] > 100 - 35) {
         EXPECT_NEAR(std::hypot(p[0] - 25, p[1] - 65), 15, 1e-6);
       }
@@ -245,7 +229,7 @@ TEST(SvgShapes, CircleAndEllipseLieOnTheirCurves) {
     const bool ellipse = c.origin.find("<ellipse id=\"e\">") != std::string::npos;
     saw_ellipse |= ellipse;
     for (double u = 0; u <= 1; u += 0.1) {
-      const Point3 p = At(c, u);
+      const Point3 p = BezierAt(c, u);
       if (ellipse) {
         // (x − 30)²/20² + (y − 60)²/10² = 1 to within the bound (1e-6 mm
         // in distance; the implicit form's gradient is ≥ 2/20).
@@ -447,7 +431,7 @@ double WorstArcDistance(const ArcCase& a, double tolerance) {
   double worst = 0;
   for (const Curve& c : set.curves) {
     for (int i = 0; i <= 10; ++i) {
-      worst = std::max(worst, DistanceToEllipse(At(c, i / 10.0), page));
+      worst = std::max(worst, DistanceToEllipse(BezierAt(c, i / 10.0), page));
     }
   }
   return worst;
