@@ -48,16 +48,7 @@ class StrokeVisibility {
 
   // The exact point at `param` in output space, with its depth (also in 2-D).
   FDSURF_NODISCARD Vec At(double param) const {
-    Point3 model{};
-    if (stroke_.curve >= 0) {
-      model = EvaluateCurve(set_.curves[static_cast<std::size_t>(stroke_.curve)], param);
-    } else {
-      const Patch& patch = set_.patches[stroke_.patch];
-      model = stroke_.family == IsolineFamily::kSLines
-                  ? EvaluateReference(patch, stroke_.line_param, param)
-                  : EvaluateReference(patch, param, stroke_.line_param);
-    }
-    return path_.map.Apply(model);
+    return ExactStrokePointWithDepth(set_, path_, stroke_, param);
   }
 
   FDSURF_NODISCARD bool Visible(const Vec& point) const {

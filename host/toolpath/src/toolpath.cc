@@ -526,8 +526,8 @@ std::array<Point3, 4> BezierFromPower(const std::array<Point3, 4>& power) {
   return bezier;
 }
 
-std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
-                                       const Stroke& stroke, double param) {
+std::array<double, 3> ExactStrokePointWithDepth(const PatchSet& set, const Toolpath& path,
+                                                const Stroke& stroke, double param) {
   Point3 p{};
   if (stroke.curve >= 0) {
     p = EvaluateCurve(set.curves[static_cast<std::size_t>(stroke.curve)], param);
@@ -537,7 +537,12 @@ std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path
             ? EvaluateReference(patch, stroke.line_param, param)
             : EvaluateReference(patch, param, stroke.line_param);
   }
-  auto out = path.map.Apply(p);
+  return path.map.Apply(p);
+}
+
+std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
+                                       const Stroke& stroke, double param) {
+  auto out = ExactStrokePointWithDepth(set, path, stroke, param);
   if (path.dims == 2) out[2] = 0;
   return out;
 }

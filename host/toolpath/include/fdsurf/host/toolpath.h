@@ -187,8 +187,13 @@ Toolpath BuildToolpath(const PatchSet& set, const ToolpathOptions& options,
 /// (ascending: power[k] multiplies u^k), exact up to double rounding.
 std::array<Point3, 4> BezierFromPower(const std::array<Point3, 4>& power);
 
-/// The exact point of an isoline in output units (the double reference,
-/// through the same map), for checks.
+/// The exact point of a stroke's isoline or curve at `param`, in output units
+/// with its depth along the view (also for 2-D output): the double
+/// reference through the same map.
+std::array<double, 3> ExactStrokePointWithDepth(const PatchSet& set, const Toolpath& path,
+                                                const Stroke& stroke, double param);
+
+/// The same as output holds it (z = 0 in 2-D), for checks.
 std::array<double, 3> ExactStrokePoint(const PatchSet& set, const Toolpath& path,
                                        const Stroke& stroke, double param);
 
