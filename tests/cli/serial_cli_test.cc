@@ -3,7 +3,8 @@
 // against the pty device fixture (tests/support/pty_device.cc): the
 // firmware on the master side of a real kernel pseudo-terminal, behaving as
 // boards do (silent after a reset, hanging up and coming back, never
-// answering). Every process here runs under a timeout.
+// answering), and pausing between layers with stdin a terminal (a second
+// pty). Every process here runs under a timeout.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -13,6 +14,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -107,13 +109,32 @@ class SerialCli : public ::testing::Test {
     return report;
   }
 
-  // Starts fdsurf with `args` (its outputs to files); returns its pid.
-  pid_t Spawn(const std::string& args) {
+  // The fixture's report as it is now (SIGUSR1), while it goes on.
+  std::map<std::string, std::string> Snapshot() {
+    std::map<std::string, std::string> report;
+    const fs::path path = dir_ / "report";
+    fs::remove(path);
+    kill(device_, SIGUSR1);
+    const auto start = Clock::now();
+    while (!fs::exists(path) && SecondsSince(start) < 5) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    std::istringstream lines(Slurp(path));
+    for (std::string key, value; lines >> key >> value;) report[key] = value;
+    return report;
+  }
+
+  // Starts fdsurf with `args` (its outputs to files, stdin `stdin_fd` or
+  // else /dev/null); returns its pid.
+  pid_t Spawn(const std::string& args, int stdin_fd = -1) {
     const std::string command = std::string("exec '") + FDSURF_BINARY + "' " + args + " >'" +
                                 (dir_ / "stdout").string() + "' 2>'" + (dir_ / "stderr").string() +
-                                "' </dev/null";
+                                "'" + (stdin_fd < 0 ? " </dev/null" : "");
+    // A second run in one test: the first one's stderr must not count.
+    fs::remove(dir_ / "stderr");
     const pid_t pid = fork();
     if (pid == 0) {
+      if (stdin_fd >= 0) dup2(stdin_fd, STDIN_FILENO);
       execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }
@@ -134,10 +155,138 @@ class SerialCli : public ::testing::Test {
     return Run("stream " + kJob + " --device 'serial:" + link_ + "' " + extra);
   }
 
+  // Waits (at most `timeout_s`) until fdsurf's stderr contains `text`.
+  bool WaitForStderr(const std::string& text, double timeout_s = 20) {
+    const auto start = Clock::now();
+    while (Slurp(dir_ / "stderr").find(text) == std::string::npos) {
+      if (SecondsSince(start) > timeout_s) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return true;
+  }
+
   fs::path dir_;
   std::string link_;
   pid_t device_ = -1;
 };
+
+// A terminal for fdsurf's stdin: the slave of a second pty, so that
+// isatty(0) holds; the test types on the master.
+struct Terminal {
+  int master = -1;
+  int slave = -1;
+  Terminal() {
+    master = posix_openpt(O_RDWR | O_NOCTTY);
+    if (master < 0 || grantpt(master) != 0 || unlockpt(master) != 0) return;
+    slave = open(ptsname(master), O_RDWR | O_NOCTTY);
+  }
+  ~Terminal() {
+    if (slave >= 0) close(slave);
+    if (master >= 0) close(master);
+  }
+  Terminal(const Terminal&) = delete;
+  Terminal& operator=(const Terminal&) = delete;
+  void Type(const std::string& text) const {
+    ASSERT_EQ(write(master, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  }
+};
+
+// Two layers (tool changes) of straight lines. By the order stream sends a
+// file's curves (docs/protocol.md, MOVE): CONFIG, then layer T1 = travel
+// MOVE, pen down, 2 line MOVEs; pen up; layer T2 = travel MOVE, pen down, 1
+// line MOVE, pen up. So layer 2 starts at command 6, of 10 in all.
+const char* const kTwoLayers =
+    "G21 G90\n"
+    "T1 M6\n"
+    "G0 X0 Y0\nM3\nG1 X20 Y0\nG1 X20 Y20\nM5\n"
+    "T2 M6\n"
+    "G0 X30 Y0\nM3\nG1 X50 Y0\nM5\n";
+constexpr int kBeforeLayer2 = 6;
+constexpr int kLayeredCommands = 10;
+
+class SerialPause : public SerialCli {
+ protected:
+  std::string LayeredStream(const std::string& extra = "") {
+    const fs::path path = dir_ / "layers.gcode";
+    std::ofstream(path) << kTwoLayers;
+    return "stream '" + path.string() + "' --view top --fit none --device 'serial:" + link_ + "' " +
+           extra;
+  }
+  const std::string prompt_ = "fdsurf: layer 2/2 'T2': change the pen, then press Enter\n";
+};
+
+// With stdin a terminal the job waits at the layer boundary with exactly
+// layer 1 executed, the device at rest with the pen up and nothing moving,
+// and after Enter runs layer 2: every command once, the same steps in the
+// same order as a run that does not pause.
+TEST_F(SerialPause, WaitsForEnterWithNothingOfLayer2Executed) {
+  StartDevice("--speedup 20");
+  ASSERT_EQ(Run(LayeredStream("--no-pause")).exit_code, 0);
+  auto clean = StopDevice();
+  ASSERT_EQ(clean["executed"], std::to_string(kLayeredCommands));
+
+  StartDevice("--speedup 20");
+  const Terminal terminal;
+  ASSERT_GE(terminal.slave, 0);
+  const auto start = Clock::now();
+  const pid_t pid = Spawn(LayeredStream(), terminal.slave);
+  ASSERT_TRUE(WaitForStderr(prompt_)) << Slurp(dir_ / "stderr");
+  auto paused = Snapshot();
+  EXPECT_EQ(paused["executed"], std::to_string(kBeforeLayer2));
+  EXPECT_EQ(paused["idle"], "1");
+  EXPECT_EQ(paused["pen_down"], "0");
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // still waiting, nothing moves
+  auto later = Snapshot();
+  EXPECT_EQ(later["executed"], std::to_string(kBeforeLayer2));
+  EXPECT_EQ(later["digest"], paused["digest"]);
+  EXPECT_EQ(Slurp(dir_ / "stderr").find("going on"), std::string::npos);
+  terminal.Type("\n");
+  const Result r = Finish(pid, start);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(prompt_ + "fdsurf: layer 2/2 'T2': going on\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 curves in 2 layers drawn by serial " + link_), std::string::npos)
+      << r.err;
+  auto report = StopDevice();
+  EXPECT_EQ(report["executed"], std::to_string(kLayeredCommands));
+  EXPECT_EQ(report["accepted"], std::to_string(kLayeredCommands));
+  EXPECT_EQ(report["duplicates"], "0");
+  EXPECT_EQ(report["hellos"], "2");  // the new session, then the resume after the pause
+  EXPECT_EQ(report["digest"], clean["digest"]);
+  EXPECT_EQ(report["pen_down"], "0");
+}
+
+TEST_F(SerialPause, GoesOnWithoutWaitingWhenStdinIsNotATerminal) {
+  StartDevice("--speedup 20");
+  const Result r = Run(LayeredStream());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(prompt_ + "fdsurf: going on without waiting (stdin is not a terminal); " +
+                       std::to_string(kBeforeLayer2) + " of " + std::to_string(kLayeredCommands) +
+                       " commands executed\n"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(StopDevice()["executed"], std::to_string(kLayeredCommands));
+}
+
+TEST_F(SerialPause, CtrlCDuringThePauseStopsAndExits130) {
+  StartDevice("--speedup 20");
+  const Terminal terminal;
+  ASSERT_GE(terminal.slave, 0);
+  const auto start = Clock::now();
+  const pid_t pid = Spawn(LayeredStream(), terminal.slave);
+  ASSERT_TRUE(WaitForStderr(prompt_)) << Slurp(dir_ / "stderr");
+  kill(pid, SIGINT);
+  const Result r = Finish(pid, start, 20);
+  EXPECT_EQ(r.exit_code, 130) << r.err;
+  EXPECT_NE(r.err.find("fdsurf: stopped: serial " + link_ + " is at rest (idle, pen up) after " +
+                       std::to_string(kBeforeLayer2) + " of " + std::to_string(kLayeredCommands) +
+                       " commands executed"),
+            std::string::npos)
+      << r.err;
+  auto report = StopDevice();
+  EXPECT_EQ(report["executed"], std::to_string(kBeforeLayer2));
+  EXPECT_EQ(report["stops"], "1");
+  EXPECT_EQ(report["pen_down"], "0");
+}
 
 TEST_F(SerialCli, StreamsAJobThatTheDeviceExecutesOnce) {
   StartDevice("--speedup 20");

@@ -20,7 +20,10 @@
 // Prints "ready" once the link exists. On SIGTERM, SIGINT or the time limit
 // (30 s) it writes the report (key value lines: executed commands, steps per
 // axis, a digest of every step and pen change in order, stops received,
-// HELLOs, duplicates, pen state, whether it was at rest) and exits 0.
+// HELLOs, duplicates, pen state, whether it was at rest) and exits 0. On
+// SIGUSR1 it writes the report as it is now and goes on (a snapshot, e.g.
+// while the host pauses between layers). The report is renamed into place,
+// so a reader never sees half of one.
 #include <fcntl.h>
 #include <poll.h>
 #include <pty.h>
@@ -42,7 +45,9 @@
 namespace {
 
 volatile sig_atomic_t g_quit = 0;
+volatile sig_atomic_t g_snapshot = 0;
 void OnSignal(int) { g_quit = 1; }
+void OnSnapshot(int) { g_snapshot = 1; }
 
 struct Options {
   std::string link;
@@ -218,7 +223,8 @@ struct Run {
 
   void Report() const {
     if (o.report.empty()) return;
-    FILE* f = std::fopen(o.report.c_str(), "w");
+    const std::string temporary = o.report + ".new";
+    FILE* f = std::fopen(temporary.c_str(), "w");
     if (f == nullptr) return;
     const auto& stats = device.link_stats();
     std::fprintf(f, "executed %u\nsteps_x %llu\nsteps_y %llu\ndigest %016llx\n", device.executed(),
@@ -230,6 +236,7 @@ struct Run {
                  outputs.pen_down ? 1 : 0, device.Idle() ? 1 : 0);
     std::fprintf(f, "bytes_in %ld\n", bytes_in);
     std::fclose(f);
+    std::rename(temporary.c_str(), o.report.c_str());
   }
 };
 
@@ -242,6 +249,9 @@ int main(int argc, char** argv) {
   action.sa_handler = OnSignal;
   sigaction(SIGTERM, &action, nullptr);
   sigaction(SIGINT, &action, nullptr);
+  struct sigaction snapshot {};
+  snapshot.sa_handler = OnSnapshot;
+  sigaction(SIGUSR1, &snapshot, nullptr);
   signal(SIGPIPE, SIG_IGN);
   auto run = std::make_unique<Run>(o);
   if (!run->pty.Open(o.link)) return 1;
@@ -255,6 +265,10 @@ int main(int argc, char** argv) {
     run->Service();
     run->device.Fill();
     run->Tick(start);
+    if (g_snapshot != 0) {
+      g_snapshot = 0;
+      run->Report();
+    }
   }
   run->Report();
   run->pty.Close();

@@ -4,7 +4,8 @@
 // recorded steps are never closer than one tick period and never faster than
 // the speed limit. The runner's old policy (an absolute schedule that fires
 // the missed ticks back to back) runs through the same loop as the reference
-// that must fail both checks.
+// that must fail both checks. Also the pause between layers: the loop keeps
+// ticking with the outputs at rest (RunIdleTicks).
 #include "../fdsurf/runners/tick_loop.h"
 
 #include <gtest/gtest.h>
@@ -86,6 +87,13 @@ protocol::Command Move(std::int32_t x) {
   return command;
 }
 
+protocol::Command Pen(bool down) {
+  protocol::Command command;
+  command.type = protocol::MessageType::kPen;
+  command.body.pen.down = down ? 1 : 0;
+  return command;
+}
+
 struct RunResult {
   sim::MotionReport report;
   std::vector<std::uint64_t> step_times;  // µs, one per Step() call
@@ -158,6 +166,105 @@ TEST(GpioTickLoop, TheOldAbsoluteScheduleBurstsAfterTheStall) {
   ASSERT_EQ(run.step_times.size(), 3000u);
   EXPECT_EQ(ShortestSpan(run.step_times, 1), 0u);  // steps back to back
   EXPECT_EQ(ShortestSpan(run.step_times, 8), 0u);  // 40 of them in no time
+}
+
+// Two layers as the GPIO runner runs them: layer 1 (CONFIG, pen down, a
+// 1000-step line, pen up) to the end, a pause of `pause_ticks` idle ticks
+// (RunIdleTicks) or, with `tick_during_pause` false, the same time without
+// ticks, then layer 2 (pen down, a line back to 0, pen up).
+struct LayeredRun {
+  std::size_t step_events_at_pause = 0;
+  std::size_t pen_events_at_pause = 0;
+  std::size_t step_events_after_pause = 0;
+  std::size_t pen_events_after_pause = 0;
+  std::uint32_t executed_at_pause = 0;
+  bool pen_down_at_pause = true;
+  bool idle_at_pause = false;
+  std::uint64_t pause_ticks = 0;  // ticks made during the pause
+  std::uint64_t late_ticks_before_layer2 = 0;
+  std::uint64_t late_ticks = 0;
+  std::uint64_t max_lateness_us = 0;
+  std::uint32_t executed = 0;
+  std::int64_t position = -1;
+  bool finished = false;
+  std::uint64_t violations = 0;
+};
+
+LayeredRun RunTwoLayers(std::uint64_t pause_ticks, bool tick_during_pause) {
+  hal::SimClock time(1'000'000);
+  StallingClock clock(time, UINT64_MAX, 0);
+  hal::SimStepDir steppers(time, 2);
+  hal::SimPen pen(time);
+  auto device = std::make_unique<device::Device<2>>(kTickHz);
+  HostLink link;
+  hal::TickScheduler ticks(clock, kPeriod);
+  const auto none = [](std::uint64_t) {};
+  for (const protocol::Command& c : {Config(), Pen(true), Move(1000), Pen(false)}) {
+    EXPECT_TRUE(link.Enqueue(c, "layer 1").ok());
+  }
+  EXPECT_EQ(RunTickLoop(clock, ticks, link, *device, steppers, pen, none), hal::IoStatus::kOk);
+  LayeredRun run;
+  run.step_events_at_pause = steppers.events().size();
+  run.pen_events_at_pause = pen.events().size();
+  run.executed_at_pause = device->executed();
+  run.pen_down_at_pause = pen.down();
+  run.idle_at_pause = device->Idle() && link.Finished();
+  // The user takes the pause's time whatever the loop does meanwhile.
+  const std::uint64_t pause_end = time.now_us() + pause_ticks * kPeriod;
+  const std::uint64_t ticks_before_pause = ticks.ticks();
+  if (tick_during_pause) {
+    EXPECT_EQ(RunIdleTicks(clock, ticks, link, *device, steppers, pen, pause_ticks),
+              hal::IoStatus::kOk);
+  }
+  time.Set(std::max(time.now_us(), pause_end));
+  run.pause_ticks = ticks.ticks() - ticks_before_pause;
+  run.step_events_after_pause = steppers.events().size();
+  run.pen_events_after_pause = pen.events().size();
+  run.late_ticks_before_layer2 = ticks.late_ticks();
+  for (const protocol::Command& c : {Pen(true), Move(0), Pen(false)}) {
+    EXPECT_TRUE(link.Enqueue(c, "layer 2").ok());
+  }
+  EXPECT_EQ(RunTickLoop(clock, ticks, link, *device, steppers, pen, none), hal::IoStatus::kOk);
+  run.late_ticks = ticks.late_ticks();
+  run.max_lateness_us = ticks.max_lateness_us();
+  run.executed = device->executed();
+  run.position = steppers.position(0);
+  run.finished = link.Finished();
+  sim::MotionLimitsSi limits;
+  limits.tick_hz = kTickHz;
+  limits.max_rate = kMaxRate;
+  limits.accel = kAccel;
+  run.violations = sim::CheckMotion(steppers.events(), pen.events(), limits).violations;
+  return run;
+}
+
+// A pause of 2 s (20000 ticks): nothing steps or moves the pen while it
+// lasts, the device rests with the pen up and exactly layer 1 executed, the
+// ticks keep their schedule (none late), and layer 2 then runs within the
+// limits with every command executed once.
+TEST(GpioTickLoop, ThePauseBetweenLayersKeepsTickingWithTheOutputsAtRest) {
+  const LayeredRun run = RunTwoLayers(20000, true);
+  EXPECT_EQ(run.executed_at_pause, 4u);
+  EXPECT_TRUE(run.idle_at_pause);
+  EXPECT_FALSE(run.pen_down_at_pause);
+  EXPECT_EQ(run.step_events_after_pause, run.step_events_at_pause);
+  EXPECT_EQ(run.pen_events_after_pause, run.pen_events_at_pause);
+  EXPECT_EQ(run.pause_ticks, 20000u);
+  EXPECT_EQ(run.late_ticks, 0u);
+  ASSERT_TRUE(run.finished);
+  EXPECT_EQ(run.executed, 7u);
+  EXPECT_EQ(run.position, 0);
+  EXPECT_EQ(run.violations, 0u);
+}
+
+TEST(GpioTickLoop, APauseWithoutTicksWouldBeReportedAsALateTick) {
+  // Why the pause ticks: the same wait without ticks is one tick 2 s late,
+  // which the runner's summary would report as a stretched motion.
+  const LayeredRun run = RunTwoLayers(20000, false);
+  ASSERT_TRUE(run.finished);
+  EXPECT_EQ(run.late_ticks_before_layer2, 0u);
+  EXPECT_EQ(run.late_ticks, 1u);
+  EXPECT_GE(run.max_lateness_us, 20000 * kPeriod - kPeriod);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: MIT
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -13,6 +14,96 @@
 #include "tick_loop.h"
 
 namespace fdsurf::host {
+namespace {
+
+// Everything a job on the GPIO lines runs with, apart from the Device.
+struct GpioRig {
+  GpioRig(hal::GpiodOutputs& lines, std::uint32_t tick_hz, bool quiet)
+      // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
+      : ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz),
+        link(LinkOptions()),
+        outputs(lines),
+        progress(ShowProgress(quiet)) {}
+
+  hal::MonotonicClock clock;
+  hal::TickScheduler ticks;
+  HostLink link;
+  hal::GpiodOutputs& outputs;
+  ProgressLine progress;
+};
+
+// Ticks `device` while `keep_going()`; DeviceError when an output fails.
+template <class Device, class KeepGoing>
+void Tick(GpioRig& rig, Device& device, std::uint64_t total_commands, KeepGoing keep_going) {
+  std::uint64_t last_progress = 0;
+  const auto show_progress = [&](std::uint64_t now) {
+    if (now - last_progress <= 250'000) return;
+    last_progress = now;
+    rig.progress.Show(device.executed(), total_commands, rig.link.stats().frames_sent, 0);
+  };
+  if (RunTickLoopWhile(rig.clock, rig.ticks, rig.link, device, rig.outputs, rig.outputs,
+                       show_progress, keep_going) != hal::IoStatus::kOk) {
+    throw DeviceError(std::string("gpio: ") + rig.outputs.StepDirOutputs::LastError());
+  }
+}
+
+// After Ctrl-C: STOP through the link (the device decelerates along its path
+// and lifts the pen), ticks until it rests (10 s at most), what was done; 130.
+template <class Device>
+int StopAtRest(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device& device) {
+  rig.progress.Finish();
+  if (!o.quiet) std::fprintf(stderr, "fdsurf: interrupted: stopping the device\n");
+  rig.link.RequestStop();
+  const std::uint64_t deadline = rig.clock.NowMicros() + 10'000'000;
+  Tick(rig, device, job.commands.size(), [&] {
+    return !(rig.link.StopAcknowledged() && device.Idle()) && rig.clock.NowMicros() < deadline;
+  });
+  const bool pen_down = device.motion().pen_down();
+  std::fprintf(stderr,
+               "fdsurf: stopped: gpio %s is %s (pen %s) after %u of %zu commands executed\n",
+               o.device.c_str(), device.Idle() ? "at rest" : "NOT at rest",
+               pen_down ? "down" : "up", device.executed(), job.commands.size());
+  return 130;
+}
+
+// The job layer by layer (as the other runners): a layer runs until the link
+// reports it executed and the device idle, then the pause for the pen change
+// keeps the ticks going (RunIdleTicks, 20 ms a slice) until Enter. 0, or
+// 130 after Ctrl-C.
+template <class Device>
+int RunLayers(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device& device,
+              std::uint32_t tick_hz) {
+  HostLink& link = rig.link;
+  for (std::size_t from = 0;;) {
+    const std::size_t to = NextLayerBoundary(job, from);
+    rig.progress.SetLayer(LayerLabel(job, from));
+    Enqueue(job, &link, from, to);
+    Tick(rig, device, job.commands.size(),
+         [&] { return !link.Finished() && !link.Failed() && !InterruptGuard::Interrupted(); });
+    if (InterruptGuard::Interrupted()) return StopAtRest(o, job, rig, device);
+    if (link.Failed() || to == job.commands.size()) break;
+    if (device.motion().pen_down()) {
+      throw DeviceError("gpio: the pen is down at the end of " + LayerLabel(job, from) +
+                        ": not pausing for a pen change");
+    }
+    rig.progress.Finish();
+    const auto idle_slice = [&] {
+      if (RunIdleTicks(rig.clock, rig.ticks, link, device, rig.outputs, rig.outputs,
+                       std::max<std::uint64_t>(1, tick_hz / 50)) != hal::IoStatus::kOk) {
+        throw DeviceError(std::string("gpio: ") + rig.outputs.StepDirOutputs::LastError());
+      }
+    };
+    if (!PauseForLayer(o.no_pause, job, to, device.executed(), idle_slice)) {
+      return StopAtRest(o, job, rig, device);
+    }
+    from = to;
+  }
+  rig.progress.Finish();
+  if (link.Failed()) throw DeviceError("gpio device: " + DecodeDeviceError(link.error()));
+  return 0;
+}
+
+}  // namespace
 
 // This host is the controller: the firmware's Device runs here, in real time,
 // on GPIO lines (tick_loop.h). A tick can only come late, and the next one is
@@ -34,44 +125,27 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   if (hal::GpiodOutputs::Open(config, &outputs, &error) != hal::IoStatus::kOk) {
     throw DeviceError(error);
   }
-  HostLink link(LinkOptions());
-  Enqueue(job, &link);
-  ProgressLine progress(ShowProgress(o.quiet));
-  hal::MonotonicClock clock;
-  // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
-  hal::TickScheduler ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz);
-  const auto run = [&](auto& device) {
-    std::uint64_t last_progress = 0;
-    const auto show_progress = [&](std::uint64_t now) {
-      if (now - last_progress <= 250'000) return;
-      last_progress = now;
-      progress.Show(device.executed(), job.commands.size(), link.stats().frames_sent, 0);
-    };
-    if (RunTickLoop(clock, ticks, link, device, *outputs, *outputs, show_progress) !=
-        hal::IoStatus::kOk) {
-      throw DeviceError(std::string("gpio: ") + outputs->StepDirOutputs::LastError());
-    }
-  };
+  const InterruptGuard interrupts;
+  GpioRig rig(*outputs, tick_hz, o.quiet);
+  int code = 0;
   if (o.dims == 3) {
     auto device = std::make_unique<device::Device<3>>(tick_hz);
-    run(*device);
+    code = RunLayers(o, job, rig, *device, tick_hz);
   } else {
     auto device = std::make_unique<device::Device<2>>(tick_hz);
-    run(*device);
+    code = RunLayers(o, job, rig, *device, tick_hz);
   }
-  progress.Finish();
-  if (link.Failed()) throw DeviceError("gpio device: " + DecodeDeviceError(link.error()));
-  if (!o.quiet) {
-    std::fprintf(stderr, "%s: %zu patches drawn on %s at %u Hz ticks\n", o.file.c_str(),
-                 job.patches.size(), o.device.c_str(), tick_hz);
-    if (ticks.late_ticks() != 0) {
-      std::fprintf(stderr,
-                   "gpio: %llu of %llu ticks came a period or more late (longest %.1f ms): the "
-                   "motion was stretched there\n",
-                   static_cast<unsigned long long>(ticks.late_ticks()),
-                   static_cast<unsigned long long>(ticks.ticks()),
-                   static_cast<double>(ticks.max_lateness_us()) / 1000.0);
-    }
+  if (code != 0 || o.quiet) return code;
+  std::fprintf(stderr, "%s: %s drawn on %s at %u Hz ticks\n", o.file.c_str(),
+               JobContents(job).c_str(), o.device.c_str(), tick_hz);
+  const hal::TickScheduler& ticks = rig.ticks;
+  if (ticks.late_ticks() != 0) {
+    std::fprintf(stderr,
+                 "gpio: %llu of %llu ticks came a period or more late (longest %.1f ms): the "
+                 "motion was stretched there\n",
+                 static_cast<unsigned long long>(ticks.late_ticks()),
+                 static_cast<unsigned long long>(ticks.ticks()),
+                 static_cast<double>(ticks.max_lateness_us()) / 1000.0);
   }
   return 0;
 }

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "runner.h"
 
+#include <poll.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cstdio>
-#include <iostream>
 #include <regex>
 #include <string>
 
@@ -14,6 +15,66 @@
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf::host {
+namespace {
+
+volatile sig_atomic_t g_interrupts = 0;
+struct sigaction g_previous_int {};
+struct sigaction g_previous_term {};
+
+void OnInterrupt(int) {
+  g_interrupts = g_interrupts + 1;
+  if (g_interrupts >= 2) {
+    static const char kMessage[] = "\nfdsurf: interrupted again: exiting at once\n";
+    (void)!write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+    _exit(130);
+  }
+}
+
+// The index in job.layers of the layer that command `command` belongs to.
+std::size_t LayerIndex(const StreamJob& job, std::size_t command) {
+  std::size_t index = 0;
+  while (index + 1 < job.layers.size() && job.layers[index + 1].command <= command) ++index;
+  return index;
+}
+
+// Until a line (Enter) or end of file arrives on stdin, or Ctrl-C: true for
+// the line. `service` runs between the checks.
+bool WaitForEnter(const std::function<void()>& service) {
+  while (!InterruptGuard::Interrupted()) {
+    if (service) service();
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    const int ready = ::poll(&in, 1, service ? 0 : 20);
+    if (ready <= 0 || (in.revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
+    // A terminal in canonical mode is readable once a whole line is typed;
+    // a hang-up or Ctrl-D reads 0 bytes: go on then too, never spin.
+    char line[256];
+    const ssize_t got = ::read(STDIN_FILENO, line, sizeof line);
+    if (got <= 0 ||
+        std::string(line, static_cast<std::size_t>(got)).find('\n') != std::string::npos) {
+      return !InterruptGuard::Interrupted();
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+InterruptGuard::InterruptGuard() {
+  g_interrupts = 0;
+  struct sigaction action {};
+  action.sa_handler = OnInterrupt;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: a wait in poll() ends at once
+  sigaction(SIGINT, &action, &g_previous_int);
+  sigaction(SIGTERM, &action, &g_previous_term);
+}
+
+InterruptGuard::~InterruptGuard() {
+  sigaction(SIGINT, &g_previous_int, nullptr);
+  sigaction(SIGTERM, &g_previous_term, nullptr);
+}
+
+bool InterruptGuard::Interrupted() { return g_interrupts != 0; }
 
 // Status queries four times a second: enough for the progress line and for
 // noticing the end, few enough to leave the link to the commands.
@@ -97,10 +158,11 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
     std::snprintf(rate, sizeof rate, "%.2f commands/s",
                   wall > 0 ? static_cast<double>(executed) / wall : 0.0);
   }
-  std::fprintf(stderr, "\rfdsurf: [%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
-               bar.c_str(), percent, static_cast<unsigned long long>(executed),
-               static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames),
-               rate);
+  const std::string layer = layer_.empty() ? std::string() : layer_ + " ";
+  std::fprintf(
+      stderr, "\rfdsurf: %s[%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
+      layer.c_str(), bar.c_str(), percent, static_cast<unsigned long long>(executed),
+      static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate);
   shown_ = true;
 }
 
@@ -112,23 +174,38 @@ std::size_t NextLayerBoundary(const StreamJob& job, std::size_t from) {
   return job.commands.size();
 }
 
-void PauseForLayer(const StreamOptions& o, const StreamJob& job, std::size_t command,
-                   std::uint64_t executed) {
-  std::size_t index = 0;
-  while (index + 1 < job.layers.size() && job.layers[index].command != command) ++index;
-  std::fprintf(stderr, "fdsurf: layer %zu/%zu '%s': change the pen, then press Enter\n", index + 1,
-               job.layers.size(), job.layers[index].name.c_str());
-  const bool terminal = ::isatty(STDIN_FILENO) != 0;
-  if (o.no_pause || !terminal) {
-    std::fprintf(stderr, "fdsurf: going on without waiting (%s); %llu of %zu commands executed\n",
-                 o.no_pause ? "--no-pause" : "stdin is not a terminal",
-                 static_cast<unsigned long long>(executed), job.commands.size());
-    return;
+std::string LayerLabel(const StreamJob& job, std::size_t command) {
+  if (job.layers.size() < 2) return "";
+  const std::size_t index = LayerIndex(job, command);
+  return "layer " + std::to_string(index + 1) + "/" + std::to_string(job.layers.size()) + " '" +
+         job.layers[index].name + "'";
+}
+
+std::string JobContents(const StreamJob& job) {
+  std::string what;
+  if (!job.patches.empty()) what = std::to_string(job.patches.size()) + " patches";
+  if (!job.curves.empty()) {
+    what += (what.empty() ? "" : " and ") + std::to_string(job.curves.size()) + " curves";
   }
-  std::string line;
-  std::getline(std::cin, line);
-  std::fprintf(stderr, "fdsurf: layer %zu/%zu '%s': going on\n", index + 1, job.layers.size(),
-               job.layers[index].name.c_str());
+  if (what.empty()) what = std::to_string(job.commands.size()) + " commands";
+  if (job.layers.size() > 1) what += " in " + std::to_string(job.layers.size()) + " layers";
+  return what;
+}
+
+bool PauseForLayer(bool no_pause, const StreamJob& job, std::size_t command, std::uint64_t executed,
+                   const std::function<void()>& service) {
+  const std::string layer = LayerLabel(job, command);
+  std::fprintf(stderr, "fdsurf: %s: change the pen, then press Enter\n", layer.c_str());
+  const bool terminal = ::isatty(STDIN_FILENO) != 0;
+  if (no_pause || !terminal) {
+    std::fprintf(stderr, "fdsurf: going on without waiting (%s); %llu of %zu commands executed\n",
+                 no_pause ? "--no-pause" : "stdin is not a terminal",
+                 static_cast<unsigned long long>(executed), job.commands.size());
+    return !InterruptGuard::Interrupted();
+  }
+  if (!WaitForEnter(service)) return false;
+  std::fprintf(stderr, "fdsurf: %s: going on\n", layer.c_str());
+  return true;
 }
 
 void ProgressLine::Finish() {

@@ -13,8 +13,10 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "../stream_command.h"
 #include "fdsurf/host/errors.h"
@@ -48,27 +50,59 @@ void Enqueue(const StreamJob& job, HostLink* link, std::size_t from, std::size_t
 /// LayerStart other than the first), or the job's size when none does.
 std::size_t NextLayerBoundary(const StreamJob& job, std::size_t from);
 
+/// "layer 2/3 'red'" for the layer that command index `command` belongs
+/// to; empty when the job has fewer than two layers (nothing to tell apart).
+std::string LayerLabel(const StreamJob& job, std::size_t command);
+
+/// What the job draws, for the runners' summaries: "4 patches", "12 curves
+/// in 3 layers", "4 patches and 12 curves" ("N commands" when neither).
+std::string JobContents(const StreamJob& job);
+
+/// SIGINT and SIGTERM counted while it lives (the first is the runner's to
+/// act on; the second exits the process with 130); the previous handlers
+/// come back on destruction. Without one, Ctrl-C ends the process as usual.
+class InterruptGuard {
+ public:
+  InterruptGuard();
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+  /// A signal arrived since construction.
+  static bool Interrupted();
+};
+
 /// At a layer boundary (`command` = a LayerStart's command), once the device
 /// has executed everything before it and rests with the pen up: prints
 /// "fdsurf: layer 2/3 'NAME': change the pen, then press Enter" on stderr and
-/// waits for a line on stdin when stdin is a terminal and !o.no_pause;
+/// waits for a line on stdin when stdin is a terminal and !no_pause;
 /// otherwise says that it goes on without waiting (`executed` commands so
 /// far, for the message). Never blocks when stdin is not a terminal.
-void PauseForLayer(const StreamOptions& o, const StreamJob& job, std::size_t command,
-                   std::uint64_t executed);
+///
+/// While it waits, `service` is called over and over: it keeps the device
+/// going (the link read and polled, the outputs ticked) for a few
+/// milliseconds and returns; stdin is checked between calls without
+/// blocking (without a `service`, stdin is polled every 20 ms). Returns
+/// false when Ctrl-C (an InterruptGuard) ended the wait: the caller stops
+/// the job as after Ctrl-C elsewhere; true to go on with the next layer.
+bool PauseForLayer(bool no_pause, const StreamJob& job, std::size_t command, std::uint64_t executed,
+                   const std::function<void()>& service = {});
 
 /// A device moves at most one step per axis per tick: InputError naming
 /// --speed and --tick-hz when the job's speed needs more.
 void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const StreamOptions& o);
 
-/// The progress line on stderr: a bar, commands executed, frames sent, and
-/// the rate (machine time over wall time for the simulator).
+/// The progress line on stderr: the layer running (LayerLabel), a bar,
+/// commands executed, frames sent, and the rate (machine time over wall
+/// time for the simulator).
 class ProgressLine {
  public:
   explicit ProgressLine(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
   ~ProgressLine() { Finish(); }
   ProgressLine(const ProgressLine&) = delete;
   ProgressLine& operator=(const ProgressLine&) = delete;
+
+  /// The layer that the next lines show ("" for none).
+  void SetLayer(std::string label) { layer_ = std::move(label); }
 
   /// Redraws at most 10 times a second (and always when `force`).
   /// `machine_seconds` > 0 for a simulated device.
@@ -81,6 +115,7 @@ class ProgressLine {
   using Clock = std::chrono::steady_clock;
   bool enabled_;
   bool shown_ = false;
+  std::string layer_;
   Clock::time_point start_;
   Clock::time_point last_;
 };

@@ -108,6 +108,7 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   // Probing connects without reconnecting; the job reconnects after an unplug.
   TransportLoop& loop = *session.loop;
   loop.set_reconnect_timeout_ms(Milliseconds(o.reconnect_timeout_s));
+  loop.set_no_pause(o.no_pause);
   if (!loop.Connect()) {
     std::fprintf(stderr, "fdsurf: interrupted before the device answered; nothing was sent\n");
     return 130;
@@ -120,9 +121,9 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   if (code != 0 || o.quiet) return code;
   const HostLinkStats& stats = loop.link().stats();
   std::fprintf(stderr,
-               "%s: %zu patches drawn by %s (%u baud, %u Hz ticks); %llu frames sent (%llu "
+               "%s: %s drawn by %s (%u baud, %u Hz ticks); %llu frames sent (%llu "
                "resent), %llu reconnects\n",
-               o.file.c_str(), job.patches.size(), name.c_str(), spec.baud, hello.tick_hz,
+               o.file.c_str(), JobContents(job).c_str(), name.c_str(), spec.baud, hello.tick_hz,
                static_cast<unsigned long long>(stats.frames_sent),
                static_cast<unsigned long long>(stats.retransmitted),
                static_cast<unsigned long long>(loop.reconnects()));

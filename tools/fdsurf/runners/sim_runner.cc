@@ -87,6 +87,7 @@ sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
   sim::RunResult run;
   for (std::size_t from = 0;;) {
     const std::size_t to = NextLayerBoundary(job, from);
+    progress.SetLayer(LayerLabel(job, from));
     Enqueue(job, &link, from, to);
     run = plotter->Run(
         link, kTimeLimitUs,
@@ -96,7 +97,7 @@ sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
         250'000);
     if (!run.finished || to == job.commands.size()) break;
     progress.Finish();
-    PauseForLayer(o, job, to, run.executed);
+    PauseForLayer(o.no_pause, job, to, run.executed);
     from = to;
   }
   progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6, true);

@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "transport_loop.h"
 
-#include <signal.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,19 +11,6 @@
 
 namespace fdsurf::host {
 namespace {
-
-volatile sig_atomic_t g_interrupts = 0;
-struct sigaction g_previous_int {};
-struct sigaction g_previous_term {};
-
-void OnInterrupt(int) {
-  g_interrupts = g_interrupts + 1;
-  if (g_interrupts >= 2) {
-    static const char kMessage[] = "\nfdsurf: interrupted again: exiting at once\n";
-    (void)!write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
-    _exit(130);
-  }
-}
 
 std::string Seconds(std::uint64_t us) {
   char text[32];
@@ -49,23 +33,6 @@ const char* StateName(protocol::DeviceState state) {
 }
 
 }  // namespace
-
-InterruptGuard::InterruptGuard() {
-  g_interrupts = 0;
-  struct sigaction action {};
-  action.sa_handler = OnInterrupt;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // no SA_RESTART: a wait in poll() ends at once
-  sigaction(SIGINT, &action, &g_previous_int);
-  sigaction(SIGTERM, &action, &g_previous_term);
-}
-
-InterruptGuard::~InterruptGuard() {
-  sigaction(SIGINT, &g_previous_int, nullptr);
-  sigaction(SIGTERM, &g_previous_term, nullptr);
-}
-
-bool InterruptGuard::Interrupted() { return g_interrupts != 0; }
 
 TransportLoop::TransportLoop(hal::Transport& transport, TransportLoopOptions options)
     : transport_(transport), options_(std::move(options)), link_(LinkOptions()) {}
@@ -147,24 +114,48 @@ bool TransportLoop::Connect() {
 }
 
 int TransportLoop::Run(const StreamJob& job, ProgressLine* progress) {
-  Enqueue(job, &link_);
+  for (std::size_t from = 0;;) {
+    const std::size_t to = NextLayerBoundary(job, from);
+    progress->SetLayer(LayerLabel(job, from));
+    Enqueue(job, &link_, from, to);
+    if (!RunToRest(job.commands.size(), progress)) return StopAndReport(job.commands.size());
+    if (to == job.commands.size()) return 0;
+    // The job lifts the pen before every layer start (stream.cc); the
+    // device's own report must agree before anyone reaches for the pen.
+    if (link_.status()->pen_down) {
+      throw DeviceError(options_.device + ": the pen is down at the end of " +
+                        LayerLabel(job, from) + ": not pausing for a pen change");
+    }
+    if (!PauseForLayer(options_.no_pause, job, to, link_.status()->executed, [this] { Turn(); })) {
+      return StopAndReport(job.commands.size());
+    }
+    // A fresh handshake (a resume HELLO) before the next layer: the link's
+    // give-up clock starts again (the pause was no silence of the device's),
+    // and a board reset or swapped during the pen change fails here, before
+    // anything of the next layer is sent.
+    link_.Resume();
+    from = to;
+  }
+}
+
+bool TransportLoop::RunToRest(std::uint64_t total_commands, ProgressLine* progress) {
   std::uint64_t last_progress = 0;
   while (!link_.Finished() && !link_.Failed()) {
     if (InterruptGuard::Interrupted()) {
       progress->Finish();
-      return StopAndReport(job.commands.size());
+      return false;
     }
     Turn();
     const std::uint64_t now = hal::MonotonicClock::Now();
     if (now - last_progress > 250'000) {
       last_progress = now;
-      progress->Show(link_.status() ? link_.status()->executed : 0, job.commands.size(),
+      progress->Show(link_.status() ? link_.status()->executed : 0, total_commands,
                      link_.stats().frames_sent, 0);
     }
   }
   progress->Finish();
   if (link_.Failed()) throw DeviceError(options_.device + ": " + DecodeDeviceError(link_.error()));
-  return 0;
+  return true;
 }
 
 bool TransportLoop::AtRest(std::uint64_t now_us, std::string* state) {

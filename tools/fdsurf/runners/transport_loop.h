@@ -8,7 +8,13 @@
 //   const StreamJob fitted = FitJobToDevice(job, *loop.link().hello(), ...);
 //   return loop.Run(fitted, &progress);     // 0, or 130 after Ctrl-C
 //
-// Ctrl-C (SIGINT) or SIGTERM: the first sends STOP, waits (bounded) for its
+// A job with layers runs layer by layer: one layer is sent, run until the
+// device reports it all executed and itself idle with the pen up, then
+// PauseForLayer (runner.h) waits for the pen change while Turn() keeps the
+// link serviced, and a resume HELLO precedes the next layer.
+//
+// Ctrl-C (SIGINT) or SIGTERM (with an InterruptGuard, runner.h), also
+// during a pause: the first sends STOP, waits (bounded) for its
 // acknowledgement and for the device to report itself at rest, says what
 // was executed and makes Run() return 130; a second exits at once (130).
 #pragma once
@@ -35,19 +41,8 @@ struct TransportLoopOptions {
   /// After Ctrl-C: how long to wait for STOP's acknowledgement and for rest.
   std::uint32_t stop_timeout_ms = 10'000;
   bool quiet = false;
-};
-
-/// SIGINT and SIGTERM counted while it lives (the first is the loop's to
-/// act on; the second exits the process with 130); the previous handlers
-/// come back on destruction.
-class InterruptGuard {
- public:
-  InterruptGuard();
-  ~InterruptGuard();
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-  /// A signal arrived since construction.
-  static bool Interrupted();
+  /// Go on between layers without waiting for Enter (--no-pause).
+  bool no_pause = false;
 };
 
 class TransportLoop {
@@ -60,20 +55,25 @@ class TransportLoop {
   /// 10.0 s (7 sent): ..."), or the transport fails or stays away.
   bool Connect();
 
-  /// Enqueues the job and runs it to the end: 0, or 130 after Ctrl-C (see
-  /// the top of this file). Throws DeviceError as Connect() does, and when
-  /// the device refuses the job.
+  /// Runs the job to the end, layer by layer with a pause for the pen
+  /// change between them: 0, or 130 after Ctrl-C (see the top of this
+  /// file). Throws DeviceError as Connect() does, when the device refuses
+  /// the job, and when it reports the pen down at a layer's end.
   int Run(const StreamJob& job, ProgressLine* progress);
 
   FDSURF_NODISCARD HostLink& link() { return link_; }
   FDSURF_NODISCARD std::uint64_t reconnects() const { return reconnects_; }
   void set_reconnect_timeout_ms(std::uint32_t ms) { options_.reconnect_timeout_ms = ms; }
+  void set_no_pause(bool no_pause) { options_.no_pause = no_pause; }
 
  private:
   // One turn: read (up to 2 ms), hand the bytes over, poll, write;
   // reconnects and resumes after a hang-up.
   void Turn();
   void Reconnect();
+  // Turns until everything enqueued is executed and the device idle: false
+  // after Ctrl-C; DeviceError when the link failed.
+  bool RunToRest(std::uint64_t total_commands, ProgressLine* progress);
   // After Ctrl-C: STOP, then status until the device is at rest.
   int StopAndReport(std::uint64_t total_commands);
   // Status queries of our own after STOP (HostLink sends nothing more):

@@ -11,8 +11,8 @@
 namespace fdsurf::host {
 
 // A real-time loop against a USB controller (transport_loop.h): the host
-// link over bulk transfers, reconnecting and resuming after an unplug, STOP
-// on Ctrl-C.
+// link over bulk transfers, reconnecting and resuming after an unplug, a
+// pause for the pen change between layers, STOP on Ctrl-C.
 int RunUsb(const StreamOptions& o, const StreamJob& job) {
   hal::UsbSelector selector;
   std::string error;
@@ -27,14 +27,15 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
   options.connect_timeout_ms = Milliseconds(o.connect_timeout_s);
   options.reconnect_timeout_ms = Milliseconds(o.reconnect_timeout_s);
   options.quiet = o.quiet;
+  options.no_pause = o.no_pause;
   TransportLoop loop(*usb, options);
   if (!loop.Connect()) return 130;
   const StreamJob fitted = FitJobToDevice(job, *loop.link().hello(), options.device, o);
   ProgressLine progress(ShowProgress(o.quiet));
   const int code = loop.Run(fitted, &progress);
   if (code != 0 || o.quiet) return code;
-  std::fprintf(stderr, "%s: %zu patches drawn by usb %s; %llu frames sent (%llu resent)\n",
-               o.file.c_str(), job.patches.size(), selector.ToString().c_str(),
+  std::fprintf(stderr, "%s: %s drawn by usb %s; %llu frames sent (%llu resent)\n", o.file.c_str(),
+               JobContents(job).c_str(), selector.ToString().c_str(),
                static_cast<unsigned long long>(loop.link().stats().frames_sent),
                static_cast<unsigned long long>(loop.link().stats().retransmitted));
   return 0;
