@@ -19,7 +19,7 @@ namespace fdsurf::host {
 int RunCheck(const GridOptions& options) {
   const Grid grid = ParseGrid(options.grid);
   const Quantum quantum = Quantum::Parse(options.quantum, "--quantum");
-  const PatchSet set = ReadPatchFile(options.file, options.input_format);
+  const PatchSet set = ReadInput(options.file, options.input_format, options.reader);
   std::vector<PreparedPatch<3>> prepared;
   for (const Patch& patch : set.patches) {
     prepared.push_back(PrepareFixedPatch(patch, quantum, grid.steps_s, grid.steps_t));

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <utility>
+#include <vector>
 
 #include "fdsurf/forward_difference.h"
 #include "fdsurf/host/errors.h"
@@ -46,7 +47,8 @@ Grid ParseGrid(const std::string& text) {
   return grid;
 }
 
-void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format) {
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format,
+                     ReaderFlags* reader) {
   command
       ->add_option("FILE", *file,
                    "drawing: patches (.bpt, .json), an SVG drawing (.svg), a G-code program "
@@ -57,10 +59,21 @@ void AddInputOptions(CLI::App* command, std::string* file, std::string* input_fo
       ->add_option("--input-format", *input_format,
                    "the drawing's format when neither its suffix nor its content tells")
       ->check(CLI::IsMember({"bpt", "json", "obj", "ply", "svg", "gcode"}));
+  command->add_option("--arc-tolerance", reader->arc_tolerance,
+                      "SVG and G-code input: the largest distance of the cubic pieces of an arc "
+                      "from the exact arc, in the input's unit (mm for SVG; default 1e-6)");
+  command->add_option("--pen-z-below", reader->pen_z_below,
+                      "G-code input with Z words: the pen is down while Z <= this (default 0)");
+  command->add_option("--servo-down-below", reader->servo_down_below,
+                      "G-code input with M280 (servo): the pen is down while the angle is below "
+                      "this, degrees (default 50)");
+  command->add_flag("--no-block-delete", reader->no_block_delete,
+                    "G-code input: run the lines that start with / (skipped by default, as with "
+                    "a controller's block-delete switch on)");
 }
 
 void AddGridOptions(CLI::App* command, GridOptions* options) {
-  AddInputOptions(command, &options->file, &options->input_format);
+  AddInputOptions(command, &options->file, &options->input_format, &options->reader);
   command
       ->add_option("--grid", options->grid,
                    "steps per patch: N (NxN) or NxM, each 1.." + std::to_string(kMaxPatchSteps))
@@ -71,7 +84,7 @@ void AddGridOptions(CLI::App* command, GridOptions* options) {
       ->capture_default_str();
 }
 
-double ParsePositive(const std::string& text, const std::string& what, bool allow_zero) {
+double ParseNumber(const std::string& text, const std::string& what) {
   double value = 0;
   std::size_t used = 0;
   try {
@@ -82,6 +95,11 @@ double ParsePositive(const std::string& text, const std::string& what, bool allo
   if (used == 0 || used != text.size() || !std::isfinite(value)) {
     throw InputError(what + ": '" + text + "' is not a number");
   }
+  return value;
+}
+
+double ParsePositive(const std::string& text, const std::string& what, bool allow_zero) {
+  const double value = ParseNumber(text, what);
   if (value < 0 || (value == 0 && !allow_zero)) {
     throw InputError(what + ": '" + text + "' must be " +
                      (allow_zero ? "zero or more" : "greater than zero"));
@@ -270,9 +288,44 @@ void StagedOutputs::Commit() {
   staged_.clear();
 }
 
+PatchSet ReadInput(const std::string& file, const std::string& input_format,
+                   const ReaderFlags& reader) {
+  ReadOptions options;
+  if (!reader.arc_tolerance.empty()) {
+    const double tolerance = ParsePositive(reader.arc_tolerance, "--arc-tolerance");
+    options.svg.arc_tolerance = tolerance;
+    options.gcode.arc_tolerance = tolerance;
+  }
+  std::vector<std::string> gcode_flags;
+  if (!reader.pen_z_below.empty()) {
+    options.gcode.pen_z_threshold = ParseNumber(reader.pen_z_below, "--pen-z-below");
+    gcode_flags.emplace_back("--pen-z-below");
+  }
+  if (!reader.servo_down_below.empty()) {
+    options.gcode.servo_down_below = ParseNumber(reader.servo_down_below, "--servo-down-below");
+    gcode_flags.emplace_back("--servo-down-below");
+  }
+  if (reader.no_block_delete) {
+    options.gcode.skip_block_delete = false;
+    gcode_flags.emplace_back("--no-block-delete");
+  }
+  std::string format;
+  PatchSet set = ReadPatchFile(file, input_format, options, &format);
+  const std::string name = file == "-" ? "<stdin>" : file;
+  if (!reader.arc_tolerance.empty() && format != "svg" && format != "gcode") {
+    throw InputError("--arc-tolerance: " + name + " is " + format +
+                     " input, which has no arcs (the option is for SVG and G-code input)");
+  }
+  if (!gcode_flags.empty() && format != "gcode") {
+    throw InputError(gcode_flags.front() + ": " + name + " is " + format +
+                     " input (the option is for G-code input)");
+  }
+  return set;
+}
+
 PatchSet ReadDrawing(const std::string& file, const std::string& input_format,
-                     const std::string& layer, bool quiet) {
-  PatchSet set = ReadPatchFile(file, input_format);
+                     const ReaderFlags& reader, const std::string& layer, bool quiet) {
+  PatchSet set = ReadInput(file, input_format, reader);
   if (!layer.empty()) SelectLayer(&set, layer);
   if (!quiet) {
     for (const std::string& note : set.notes) {

@@ -25,22 +25,47 @@ struct Grid {
 /// "N" or "NxM", each 1..kMaxPatchSteps; InputError naming --grid otherwise.
 Grid ParseGrid(const std::string& text);
 
+/// The readers' options as typed, "" (or false) when left out
+/// (docs/formats.md): --arc-tolerance for SVG and G-code input, in the
+/// input's unit (mm for SVG); --pen-z-below, --servo-down-below and
+/// --no-block-delete for G-code input (GcodeReadOptions).
+struct ReaderFlags {
+  std::string arc_tolerance;
+  std::string pen_z_below;
+  std::string servo_down_below;
+  bool no_block_delete = false;
+};
+
 /// The options of `sample` and `check`: a file evaluated on a grid.
 struct GridOptions {
   std::string file;
   std::string input_format;
+  ReaderFlags reader;
   std::string grid;
   std::string engine = "fixed";
   std::string quantum = "0.001";
 };
 
-/// Adds FILE (a path, or - for standard input) and --input-format (bpt,
+/// Adds FILE (a path, or - for standard input), --input-format (bpt,
 /// json, obj, ply, svg, gcode: for when neither the suffix nor the content
-/// tells), as every command that reads a drawing has them.
-void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format);
+/// tells) and the reader flags, as every command that reads a drawing has them.
+void AddInputOptions(CLI::App* command, std::string* file, std::string* input_format,
+                     ReaderFlags* reader);
+
+/// Reads FILE (ReadPatchFile, with --input-format when given) with the
+/// reader flags. InputError naming the flag for a value that is not a number
+/// or an --arc-tolerance that is not > 0, and for a flag the format read does
+/// not take (--arc-tolerance but bpt, json, obj, ply; a G-code flag but not
+/// G-code): a flag that would change nothing is refused, not ignored.
+/// OptionError ("arc tolerance") and InputError as the readers throw them.
+PatchSet ReadInput(const std::string& file, const std::string& input_format,
+                   const ReaderFlags& reader);
 
 /// Adds FILE, --grid and --quantum (the options `sample` and `check` share).
 void AddGridOptions(CLI::App* command, GridOptions* options);
+
+/// A finite number; InputError naming `what` otherwise.
+double ParseNumber(const std::string& text, const std::string& what);
 
 /// A number > 0 (or ≥ 0 with allow_zero); InputError naming `what` otherwise.
 double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false);
@@ -87,12 +112,12 @@ View ParseView(const std::string& text);
 /// "tolerance" is --tolerance, "pen delay" --pen-delay, "travel X" --travel X.
 std::string FlagFor(const std::string& field);
 
-/// The drawing of `plot`, `render` and `stream`: ReadPatchFile (with
-/// --input-format when given), then only the layer `layer` names when it is
-/// not empty (--layer NAME|N, SelectLayer); the reader's "left out: ..."
-/// notes go to stderr unless `quiet`. Throws InputError as those do.
+/// The drawing of `plot`, `render` and `stream`: ReadInput, then only the
+/// layer `layer` names when it is not empty (--layer NAME|N, SelectLayer);
+/// the reader's "left out: ..." notes go to stderr unless `quiet`. Throws
+/// InputError as those do.
 PatchSet ReadDrawing(const std::string& file, const std::string& input_format,
-                     const std::string& layer, bool quiet);
+                     const ReaderFlags& reader, const std::string& layer, bool quiet);
 
 /// A drawing in the xy plane (no patches; a page of its own (SVG), a program
 /// (G-code, whose Z is the pen) or every curve at z = 0): drawn from the top

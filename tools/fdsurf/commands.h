@@ -29,6 +29,7 @@ int RunCheck(const GridOptions& options);
 struct PlotOptions {
   std::string file;
   std::string input_format;
+  ReaderFlags reader;
   std::string format;
   std::string output = "-";
   std::string png;

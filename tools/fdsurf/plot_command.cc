@@ -233,7 +233,7 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   const std::string format = OutputFormat(o, render_only);
   std::string work_units;
   ToolpathOptions t = DrawingOptions(o, format, &work_units);
-  const PatchSet set = ReadDrawing(options.file, o.input_format, o.layer, o.quiet);
+  const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) t.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
@@ -277,7 +277,7 @@ int RunPlot(const PlotOptions& options, bool render_only) {
 }
 
 void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
-  AddInputOptions(command, &o->file, &o->input_format);
+  AddInputOptions(command, &o->file, &o->input_format, &o->reader);
   if (render_only) {
     command->add_option("-o,--output", o->output, "the PNG file to write")->required();
   } else {

@@ -43,7 +43,7 @@ class Output {
 int RunSample(const GridOptions& options) {
   const Grid grid = ParseGrid(options.grid);
   const Quantum quantum = Quantum::Parse(options.quantum, "--quantum");
-  const PatchSet set = ReadPatchFile(options.file, options.input_format);
+  const PatchSet set = ReadInput(options.file, options.input_format, options.reader);
   const bool fixed = options.engine == "fixed";
   std::vector<PreparedPatch<3>> prepared;
   if (fixed) {

@@ -80,7 +80,7 @@ void RefuseOutsideTravel(const Toolpath& page, const MachineOptions& machine, Pa
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
-  AddInputOptions(command, &o->file, &o->input_format);
+  AddInputOptions(command, &o->file, &o->input_format, &o->reader);
   command
       ->add_option("--device", o->device,
                    "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
@@ -187,7 +187,7 @@ int RunStream(const StreamOptions& options) {
   }
   ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
-  const PatchSet set = ReadDrawing(options.file, o.input_format, o.layer, o.quiet);
+  const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;

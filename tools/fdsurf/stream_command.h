@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "cli_options.h"
+
 namespace CLI {
 class App;
 }
@@ -15,6 +17,7 @@ namespace fdsurf::host {
 struct StreamOptions {
   std::string file;
   std::string input_format;
+  ReaderFlags reader;
   std::string device = "sim";
   // The drawing, as for `fdsurf plot`.
   std::string lines = "8";

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "fdsurf/host/errors.h"
 #include "fdsurf/host/text.h"
@@ -24,7 +25,78 @@ double MaxAbs(const Point3& p) {
   return std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
 }
 
+// The standard cubic of the unit-circle arc from angle a to angle b:
+// b1 = b0 + k·(−sin a, cos a), b2 = b3 − k·(−sin b, cos b), k = (4/3)·tan((b − a)/4)
+// (negative for a clockwise arc, which turns the tangents round).
+std::array<PlanePoint, 4> UnitCircleCubic(double a, double b) {
+  const double k = 4.0 / 3 * std::tan((b - a) / 4);
+  const double ca = std::cos(a);
+  const double sa = std::sin(a);
+  const double cb = std::cos(b);
+  const double sb = std::sin(b);
+  return {PlanePoint{ca, sa}, PlanePoint{ca - k * sa, sa + k * ca},
+          PlanePoint{cb + k * sb, sb - k * cb}, PlanePoint{cb, sb}};
+}
+
+// The arc as `pieces` cubics of equal angle; each piece's bound is computed
+// from its own end angles (rounding makes the pieces' angles differ a little).
+CircleArcCubics CirclePieces(double start, double sweep, long pieces) {
+  CircleArcCubics out;
+  out.cubics.reserve(static_cast<std::size_t>(pieces));
+  double from = start;
+  for (long k = 1; k <= pieces; ++k) {
+    const double to = k == pieces
+                          ? start + sweep
+                          : start + sweep * (static_cast<double>(k) / static_cast<double>(pieces));
+    out.cubics.push_back(UnitCircleCubic(from, to));
+    out.unit_bound = std::max(out.unit_bound, CircleCubicBound(to - from));
+    from = to;
+  }
+  return out;
+}
+
 }  // namespace
+
+double CircleCubicBound(double sweep) {
+  // max over t of |c(t)|² − 1 = (4/27)·sin⁶(φ/4)/cos²(φ/4), and
+  // |c| − 1 = sqrt(1 + ρ) − 1 ≤ ρ/2 (docs/formats.md). The factor covers the
+  // relative rounding of these few operations (sin and cos within an ulp);
+  // denorm_min keeps the value an upper bound where s⁶ underflows.
+  const double s = std::sin(std::fabs(sweep) / 4);
+  const double c = std::cos(std::fabs(sweep) / 4);
+  const double s3 = s * s * s;
+  return 2.0 / 27 * s3 * s3 / (c * c) * (1 + 64 * kEps) + std::numeric_limits<double>::denorm_min();
+}
+
+CircleArcCubics CircleArcToCubics(double start, double sweep, double scale, double tolerance) {
+  if (!(tolerance > 0) || !std::isfinite(tolerance) || !(scale > 0) || !std::isfinite(scale) ||
+      !std::isfinite(start) || !std::isfinite(sweep) || sweep == 0) {
+    throw ConstructionError(
+        "a circular arc needs a non-zero finite sweep and a tolerance and "
+        "scale > 0 (tolerance " +
+        FormatNumber(tolerance) + ", scale " + FormatNumber(scale) + ")");
+  }
+  constexpr long kMaxPieces = 1L << 24;
+  const double angle = std::fabs(sweep);
+  long pieces = std::max(1L, static_cast<long>(std::ceil(angle / (std::numbers::pi / 2))));
+  for (;;) {
+    // The bound grows as φ⁶, so n·(bound/tolerance)^(1/6) pieces nearly
+    // meet it; the check with the pieces' own angles decides.
+    const double excess = scale * CircleCubicBound(angle / static_cast<double>(pieces)) / tolerance;
+    if (excess > 1) {
+      const double estimate = std::ceil(static_cast<double>(pieces) * std::pow(excess, 1.0 / 6));
+      pieces = std::max(pieces + 1, static_cast<long>(std::min(estimate, 2.0 * kMaxPieces)));
+    } else {
+      CircleArcCubics out = CirclePieces(start, sweep, pieces);
+      if (scale * out.unit_bound <= tolerance) return out;
+      ++pieces;
+    }
+    if (pieces > kMaxPieces) {
+      throw ConstructionError("a circular arc cannot be bounded within tolerance " +
+                              FormatNumber(tolerance) + " by 2^24 cubic pieces");
+    }
+  }
+}
 
 Point3 RationalQuadratic::At(double t) const {
   const double b0 = (1 - t) * (1 - t);

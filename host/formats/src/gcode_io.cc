@@ -9,6 +9,7 @@
 #include <cctype>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -559,11 +560,6 @@ void Interpreter::Arc(const Block& block, bool clockwise, const Point3& target, 
     sweep += 2 * kPi * (*turns - 1);
   }
   if (!drawn) return;
-  if (mismatch > options_.arc_tolerance) {
-    Note("arc end " + std::to_string(block.line), block.line,
-         code + ": the end point is " + FormatNumber(mismatch) +
-             " off the circle; the last piece is bent by at most that to meet it");
-  }
   if (position_[p.n] != target[p.n] && !drawn_helix_noted_) {
     drawn_helix_noted_ = true;
     Note("helix", block.line,
@@ -573,42 +569,64 @@ void Interpreter::Arc(const Block& block, bool clockwise, const Point3& target, 
   AddArcPieces(block.line, code, p, centre, r0, a0, clockwise ? -sweep : sweep, target);
 }
 
-// The arc as pieces of at most 90°, each the rational quadratic with
-// w = cos(half its sweep) (exactly the circle), and each of those as cubics
-// within the arc tolerance (ArcToCubics, docs/constructions.md row 12).
+// The arc as the standard cubics of the circle (CircleArcToCubics), each
+// within the arc tolerance of the circle in the plane; along the plane's
+// normal (a helix) each piece moves linearly. The ends are the machine's
+// position and the target: rounding moves them a little (the margin, taken
+// off the tolerance), an end point off the circle by what it is off (noted
+// when that is more than a quarter of the tolerance, which it then leaves).
 void Interpreter::AddArcPieces(int line, const std::string& code, const PlaneAxes& p,
                                const std::array<double, 2>& centre, double radius, double start,
                                double sweep, const Point3& target) {
-  const int pieces = std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / (kPi / 2) - 1e-9)));
-  const double step = sweep / pieces;
-  const double w = std::cos(std::fabs(step) / 2);
+  const auto in_plane = [&](double angle) {
+    return PlanePoint{centre[0] + radius * std::cos(angle), centre[1] + radius * std::sin(angle)};
+  };
+  const auto off = [&](const PlanePoint& q, const Point3& machine) {
+    return std::hypot(q[0] - machine[p.a], q[1] - machine[p.b]);
+  };
+  const double tolerance = options_.arc_tolerance;
+  const double end_off = off(in_plane(start + sweep), target);
+  if (end_off > tolerance / 4) {
+    Note("arc end " + std::to_string(line), line,
+         code + ": the end point is " + FormatNumber(end_off) +
+             " off the circle; the last piece is bent by at most that to meet it");
+  }
+  // 32 ε of the coordinates' size is generous for the few operations that
+  // make a control point (docs/formats.md, "Circular and elliptical arcs").
+  const double margin =
+      32 * std::numeric_limits<double>::epsilon() *
+          (std::fabs(centre[0]) + std::fabs(centre[1]) + 2 * radius) +
+      std::max(off(in_plane(start), position_), end_off > tolerance / 4 ? 0 : end_off);
+  if (!(margin < tolerance / 2)) {
+    throw Error(line, code +
+                          ": the arc cannot be drawn within the arc tolerance "
+                          "(--arc-tolerance) " +
+                          FormatNumber(tolerance) + ": rounding alone moves it by " +
+                          FormatNumber(margin));
+  }
+  CircleArcCubics pieces;
+  try {
+    pieces = CircleArcToCubics(start, sweep, radius, tolerance - margin);
+  } catch (const ConstructionError& e) {
+    throw Error(line, code + ": " + e.what());
+  }
+  const double n = static_cast<double>(pieces.cubics.size());
   const double lin0 = position_[p.n];
   const double lin1 = target[p.n];
-  const auto at = [&](double angle, double lin, double r) {
-    Point3 q{};
-    q[p.a] = centre[0] + r * std::cos(angle);
-    q[p.b] = centre[1] + r * std::sin(angle);
-    q[p.n] = lin;
-    return q;
-  };
   Point3 from = position_;
-  for (int k = 0; k < pieces; ++k) {
-    const double f0 = static_cast<double>(k) / pieces;
-    const double f1 = static_cast<double>(k + 1) / pieces;
-    RationalQuadratic piece;
-    piece.p0 = from;
-    piece.p1 = at(start + step * (k + 0.5), lin0 + (lin1 - lin0) * (f0 + f1) / 2, radius / w);
-    piece.p2 =
-        k + 1 == pieces ? target : at(start + step * (k + 1), lin0 + (lin1 - lin0) * f1, radius);
-    piece.w = w;
-    try {
-      for (const CubicArc& cubic : ArcToCubics(piece, options_.arc_tolerance)) {
-        AddCurve(cubic.b, line, code, false);
-      }
-    } catch (const ConstructionError& e) {
-      throw Error(line, code + ": " + e.what());
+  for (std::size_t k = 0; k < pieces.cubics.size(); ++k) {
+    const bool last = k + 1 == pieces.cubics.size();
+    std::array<Point3, 4> g{};
+    for (std::size_t i = 0; i < 4; ++i) {
+      const double f = (static_cast<double>(k) + static_cast<double>(i) / 3) / n;
+      g[i][p.a] = centre[0] + radius * pieces.cubics[k][i][0];
+      g[i][p.b] = centre[1] + radius * pieces.cubics[k][i][1];
+      g[i][p.n] = lin0 + (lin1 - lin0) * f;
     }
-    from = piece.p2;
+    g[0] = from;
+    if (last) g[3] = target;
+    AddCurve(g, line, code, false);
+    from = g[3];
   }
 }
 

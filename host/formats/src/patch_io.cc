@@ -309,24 +309,33 @@ Basis ParseBasis(const nlohmann::json& value, const JsonPlace& place) {
 
 namespace {
 
-using TextReader = PatchSet (*)(const std::string& text, const std::string& name);
+using TextReader = PatchSet (*)(const std::string& text, const std::string& name,
+                                const ReadOptions& options);
 
-PatchSet ParseObjMesh(const std::string& text, const std::string& name) {
+PatchSet ReadBptFile(const std::string& text, const std::string& name, const ReadOptions&) {
+  return ParseBpt(text, name);
+}
+
+PatchSet ReadJsonFile(const std::string& text, const std::string& name, const ReadOptions&) {
+  return ParseJson(text, name);
+}
+
+PatchSet ParseObjMesh(const std::string& text, const std::string& name, const ReadOptions&) {
   return MeshAsPatchSet(ParseObj(text, name), name);
 }
 
-PatchSet ParsePlyMesh(const std::string& bytes, const std::string& name) {
+PatchSet ParsePlyMesh(const std::string& bytes, const std::string& name, const ReadOptions&) {
   return MeshAsPatchSet(ParsePly(bytes, name), name);
 }
 
-// An SVG drawing with the reader's default arc tolerance (svg_io.h).
-PatchSet ReadSvgDrawing(const std::string& text, const std::string& name) {
-  return ReadSvg(text, name);
+PatchSet ReadSvgDrawing(const std::string& text, const std::string& name,
+                        const ReadOptions& options) {
+  return ReadSvg(text, name, options.svg);
 }
 
-// A G-code program with the reader's default conventions (gcode_io.h).
-PatchSet ReadGcodeProgram(const std::string& text, const std::string& name) {
-  return ReadGcode(text, name);
+PatchSet ReadGcodeProgram(const std::string& text, const std::string& name,
+                          const ReadOptions& options) {
+  return ReadGcode(text, name, options.gcode);
 }
 
 // Every input format: its --input-format name, the suffixes that say it (in
@@ -339,8 +348,8 @@ struct InputFormat {
 };
 
 constexpr InputFormat kInputFormats[] = {
-    {"bpt", {".bpt"}, ParseBpt},
-    {"json", {".json"}, ParseJson},
+    {"bpt", {".bpt"}, ReadBptFile},
+    {"json", {".json"}, ReadJsonFile},
     {"obj", {".obj"}, ParseObjMesh},
     {"ply", {".ply"}, ParsePlyMesh},
     {"svg", {".svg"}, ReadSvgDrawing},
@@ -404,7 +413,8 @@ std::string ReadAll(const std::string& path, const std::string& name) {
 
 }  // namespace
 
-PatchSet ReadPatchFile(const std::string& path, const std::string& format_name) {
+PatchSet ReadPatchFile(const std::string& path, const std::string& format_name,
+                       const ReadOptions& options, std::string* format_read) {
   const std::string name = path == "-" ? "<stdin>" : path;
   const InputFormat* format = nullptr;
   if (!format_name.empty()) {
@@ -430,7 +440,8 @@ PatchSet ReadPatchFile(const std::string& path, const std::string& format_name) 
   if (format->read == nullptr) {
     throw InputError(name + ": " + format->name + " input is not available");
   }
-  return format->read(text, name);
+  if (format_read != nullptr) *format_read = format->name;
+  return format->read(text, name, options);
 }
 
 }  // namespace fdsurf::host

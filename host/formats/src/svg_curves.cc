@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Path segments as the drawing's cubic curves (docs/formats.md, "SVG"):
-// lines and cubics exactly, elliptical arcs as rational quadratics mapped to
-// the page and then approximated by ArcToCubics with its proven bound.
+// lines and cubics exactly, elliptical arcs as the standard cubics of the unit
+// circle mapped to the page, with their proven bound (CircleArcToCubics).
 #include <cmath>
 #include <limits>
-#include <numbers>
 
 #include "fdsurf/host/conic_arc.h"
 #include "fdsurf/host/text.h"
@@ -58,11 +57,6 @@ void CurveSink::Arc(const Vec2& from, double rx, double ry, double rotation_deg,
   const Affine ellipse{cs * arc.rx, sn * arc.rx,   -sn * arc.ry,
                        cs * arc.ry, arc.centre[0], arc.centre[1]};
   const Affine t = to_out_.After(ellipse);
-  // Pieces of at most 90°: a unit-circle arc of half-angle h ≤ 45° is the
-  // rational quadratic (cos a, sin a), (cos m, sin m)/cos h, (cos b, sin b)
-  // with weight cos h (m the mid angle); affine maps keep the weight.
-  const double quarter = std::numbers::pi / 2;
-  const int pieces = std::max(1, static_cast<int>(std::ceil(std::abs(arc.delta) / quarter - 1e-9)));
   // What rounding may have moved: the computed ends from the file's ends
   // (measured) and every control point by a few units in the last place of
   // the page's coordinates (32 ε is generous for the handful of operations).
@@ -76,30 +70,21 @@ void CurveSink::Arc(const Vec2& from, double rx, double ry, double rotation_deg,
           Distance(t.Apply({std::cos(arc.theta1 + arc.delta), std::sin(arc.theta1 + arc.delta)}),
                    end));
   if (!(margin < arc_tolerance_ / 2)) {
-    throw SyntaxError("the arc cannot be drawn within the arc tolerance " +
+    throw SyntaxError("the arc cannot be drawn within the arc tolerance (--arc-tolerance) " +
                       FormatNumber(arc_tolerance_) + " mm: rounding alone moves it by " +
                       FormatNumber(margin) + " mm");
   }
-  for (int k = 0; k < pieces; ++k) {
-    const double a = arc.theta1 + arc.delta * k / pieces;
-    const double b = arc.theta1 + arc.delta * (k + 1) / pieces;
-    const double h = (b - a) / 2;
-    RationalQuadratic piece;
-    const Vec2 p0 = k == 0 ? start : t.Apply({std::cos(a), std::sin(a)});
-    const Vec2 p1 = t.Apply({std::cos(a + h) / std::cos(h), std::sin(a + h) / std::cos(h)});
-    const Vec2 p2 = k == pieces - 1 ? end : t.Apply({std::cos(b), std::sin(b)});
-    piece.p0 = Lift(p0);
-    piece.p1 = Lift(p1);
-    piece.p2 = Lift(p2);
-    piece.w = std::cos(h);
-    // Moving control points by ≤ margin moves every point of a rational
-    // quadratic with positive weights by ≤ margin (a convex combination), so
-    // ArcToCubics' bound plus the margin stays within the tolerance.
-    for (const CubicArc& cubic : ArcToCubics(piece, arc_tolerance_ - margin)) {
-      Add({Vec2{cubic.b[0][0], cubic.b[0][1]}, Vec2{cubic.b[1][0], cubic.b[1][1]},
-           Vec2{cubic.b[2][0], cubic.b[2][1]}, Vec2{cubic.b[3][0], cubic.b[3][1]}},
-          false);
-    }
+  // The unit circle's standard cubics, mapped: T stretches no distance by
+  // more than its largest singular value, so the mapped cubics lie within
+  // MaxStretch()·unit_bound of the mapped arc (and it of them), and moving
+  // control points by ≤ margin moves every point of a cubic by ≤ margin.
+  const CircleArcCubics pieces =
+      CircleArcToCubics(arc.theta1, arc.delta, t.MaxStretch(), arc_tolerance_ - margin);
+  for (std::size_t k = 0; k < pieces.cubics.size(); ++k) {
+    const std::array<PlanePoint, 4>& u = pieces.cubics[k];
+    Add({k == 0 ? start : t.Apply(u[0]), t.Apply(u[1]), t.Apply(u[2]),
+         k + 1 == pieces.cubics.size() ? end : t.Apply(u[3])},
+        false);
   }
 }
 

@@ -99,7 +99,7 @@ CentreArc EndpointToCentre(const Vec2& from, double rx, double ry, double rotati
 /// exactly, arcs as cubic pieces within `arc_tolerance` mm of the exact
 /// (mapped) arc. Throws SyntaxError for an arc the arithmetic cannot draw
 /// within the tolerance (coordinates so large that rounding alone exceeds
-/// half of it); ConstructionError passes through from ArcToCubics.
+/// half of it); ConstructionError passes through from CircleArcToCubics.
 class CurveSink : public PathSink {
  public:
   CurveSink(const Affine& to_out, double arc_tolerance, std::string origin, std::vector<Curve>* out)

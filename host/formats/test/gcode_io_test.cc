@@ -342,6 +342,29 @@ TEST(GcodeArcs, TheBoundIsTheOption) {
             "arc tolerance 0 must be > 0");
 }
 
+TEST(GcodeArcs, FewCubicsAtTheDefaultTolerance) {
+  // The standard circle cubic's error falls as the sixth power of the angle:
+  // a half circle of radius 10 within 1e-6 mm is 8 cubics (the Hermite
+  // cubic of the rational quadratic needed 64), a full one of 100 is 22
+  // (was 128).
+  const PatchSet half = Read("G0 X10 Y0\nG2 X-10 Y0 I-10 J0\n");
+  EXPECT_EQ(half.curves.size(), 8u);
+  ExpectArc(half, 0, half.curves.size(), kXY, {0, 0}, 10, 0, -kPi);
+  const PatchSet full = Read("G0 X100 Y0\nG3 I-100 J0\n");
+  EXPECT_EQ(full.curves.size(), 22u);
+  ExpectArc(full, 0, full.curves.size(), kXY, {0, 0}, 100, 0, 2 * kPi);
+}
+
+TEST(GcodeArcs, RefusesAToleranceTheArithmeticCannotMeet) {
+  GcodeReadOptions fine;
+  fine.arc_tolerance = 1e-14;
+  EXPECT_EQ(ErrorOf([&] { (void)Read("G0 X100 Y0\nG3 I-100 J0\n", fine); })
+                .rfind("p.gcode:2: G3: the arc cannot be drawn within the arc tolerance "
+                       "(--arc-tolerance) 1e-14: rounding alone moves it by ",
+                       0),
+            0u);
+}
+
 TEST(GcodeArcs, Errors) {
   EXPECT_EQ(ReadError("G1 X1\nG2 X2 Y0 R1 I1\n"), "p.gcode:2: G2: R and I/J given together");
   EXPECT_EQ(ReadError("G2 X2 Y0\n"), "p.gcode:1: G2: neither R nor I/J given");

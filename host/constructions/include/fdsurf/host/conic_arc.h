@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Conic arcs as rational quadratic Bézier curves, and their approximation by
 // cubic Bézier curves with a proven bound (docs/constructions.md, row 12,
-// "The cubic approximation of a conic arc").
+// "The cubic approximation of a conic arc"); circular arcs and their affine
+// images (ellipses) with the standard circle cubic and a proven geometric
+// bound (docs/formats.md, "Circular and elliptical arcs").
 #pragma once
 
 #include <array>
@@ -56,5 +58,38 @@ FDSURF_NODISCARD CubicArc ApproximateArc(const RationalQuadratic& arc);
 std::vector<CubicArc> ArcToCubics(
     const RationalQuadratic& arc, double tolerance,
     const std::function<double(const RationalQuadratic&)>& extra = nullptr);
+
+/// A point in a plane, (x, y).
+using PlanePoint = std::array<double, 2>;
+
+/// A circular arc as cubic Bézier curves: the control points on the unit
+/// circle about the origin, to be mapped by the caller (a circle: centre +
+/// r·p; an ellipse: any affine map).
+struct CircleArcCubics {
+  /// The arc's pieces in order, all of the same angle; consecutive pieces
+  /// share their end point bit for bit.
+  std::vector<std::array<PlanePoint, 4>> cubics;
+  /// Every point of each cubic is within this distance of its piece of the
+  /// unit circle and every point of the piece within it of the cubic (the
+  /// Hausdorff distance), before the caller's map and without the rounding
+  /// of the control points (the caller's margin).
+  double unit_bound = 0;
+};
+
+/// The Hausdorff distance bound of the standard cubic of a unit-circle arc of
+/// angle `sweep` radians (|sweep| ≤ π/2): (2/27)·sin⁶(φ/4)/cos²(φ/4), φ =
+/// |sweep|, rounded up (docs/formats.md). The standard cubic has b1 = b0 +
+/// k·(tangent at b0), b2 = b3 − k·(tangent at b3), k = (4/3)·tan(φ/4).
+FDSURF_NODISCARD double CircleCubicBound(double sweep);
+
+/// The unit-circle arc from angle `start` over `sweep` (radians, signed:
+/// positive counter-clockwise, non-zero) as the fewest equal pieces of at
+/// most 90° whose standard cubics have scale·unit_bound ≤ tolerance. `scale`
+/// is the largest singular value of the map the caller applies afterwards
+/// (the radius for a circle), which stretches no distance by more than that.
+/// Throws ConstructionError when tolerance or scale is not > 0 and finite or
+/// when that takes more than 2^24 pieces.
+FDSURF_NODISCARD CircleArcCubics CircleArcToCubics(double start, double sweep, double scale,
+                                                   double tolerance);
 
 }  // namespace fdsurf::host

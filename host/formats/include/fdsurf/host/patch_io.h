@@ -5,11 +5,21 @@
 #include <string>
 
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/gcode_io.h"
 #include "fdsurf/host/mesh_io.h"
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/quadric_hermite.h"
+#include "fdsurf/host/svg_io.h"
 
 namespace fdsurf::host {
+
+/// The options of the readers that take any: each format's reader gets its
+/// own (SVG's arc tolerance in mm on the page, G-code's in the program's
+/// unit, and G-code's pen conventions); the other readers take none.
+struct ReadOptions {
+  SvgOptions svg;
+  GcodeReadOptions gcode;
+};
 
 /// Reads a BPT or JSON patch file, or an OBJ or PLY triangle mesh drawn as
 /// quadric Hermite pieces (curves; docs/formats.md). `path` "-" reads all of
@@ -19,8 +29,11 @@ namespace fdsurf::host {
 /// JSON, '<' SVG, "ply" PLY, a digit BPT, an OBJ statement or '#' comment, a
 /// G-code word or comment. Throws InputError on an unknown `format`, content
 /// whose format cannot be told, a format this build cannot read, anything
-/// malformed or a mesh the construction refuses.
-PatchSet ReadPatchFile(const std::string& path, const std::string& format = "");
+/// malformed or a mesh the construction refuses; OptionError as the SVG and
+/// G-code readers do for their options. `format_read`, when given, receives
+/// the name of the format that was read (bpt, json, obj, ply, svg, gcode).
+PatchSet ReadPatchFile(const std::string& path, const std::string& format = "",
+                       const ReadOptions& options = {}, std::string* format_read = nullptr);
 
 /// The construction a mesh file is drawn by (docs/formats.md): μ from its
 /// normals, the normals turned where the triangles' conditions need it,
