@@ -213,15 +213,7 @@ void RemoveHidden(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
                   const std::string& work_units, Toolpath* path) {
   const HiddenLineOptions hidden = HiddenLineDefaults(t.tolerance);
   const HiddenLineReport r = RemoveHiddenLines(set, hidden, path);
-  if (o.quiet) return;
-  const char* u = work_units.c_str();
-  std::fprintf(stderr,
-               "hidden: %zu strokes -> %zu visible pieces; drawn %.1f -> %.1f %s; %zu points "
-               "tested in %.2f s (depth margin %s %s, cuts located within %s %s, samples at "
-               "most %s %s apart)\n",
-               r.strokes_before, r.strokes_after, r.length_before, r.length_after, u, r.queries,
-               r.seconds, FormatNumber(hidden.eps).c_str(), u, FormatNumber(hidden.locate).c_str(),
-               u, FormatNumber(hidden.spacing).c_str(), u);
+  if (!o.quiet) std::fprintf(stderr, "%s\n", DescribeHiddenLines(r, hidden, work_units).c_str());
 }
 
 }  // namespace

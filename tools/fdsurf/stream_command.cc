@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli_options.h"
+#include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/host/text.h"
@@ -75,6 +76,37 @@ void RefuseOutsideTravel(const Toolpath& page, const MachineOptions& machine, Pa
                    " " + page.units + ", outside the machine's travel x 0.." +
                    FormatNumber(travel[0]) + ", y 0.." + FormatNumber(travel[1]) +
                    "; use --origin min or center to place it on the page");
+}
+
+enum class DeviceKind { kSim, kUsb, kSerial, kGpio, kUnknown };
+
+DeviceKind DeviceKindOf(const std::string& device) {
+  if (device == "sim") return DeviceKind::kSim;
+  if (device == "usb" || device.rfind("usb:", 0) == 0) return DeviceKind::kUsb;
+  if (device.rfind("serial:", 0) == 0) return DeviceKind::kSerial;
+  if (device.rfind("gpio:", 0) == 0) return DeviceKind::kGpio;
+  return DeviceKind::kUnknown;
+}
+
+// Builds the job of `set` and streams it to the device o.device names.
+int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptions& drawing,
+                const MachineOptions& machine) {
+  const StreamJob job = BuildStreamJob(set, drawing, machine, o.units);
+  try {
+    switch (DeviceKindOf(o.device)) {
+      case DeviceKind::kSim:
+        return RunSimulated(o, set, job, drawing, o.units);
+      case DeviceKind::kUsb:
+        return RunUsb(o, job);
+      case DeviceKind::kSerial:
+        return RunSerial(o, job);
+      default:
+        return RunGpio(o, job);
+    }
+  } catch (const DeviceError& e) {
+    std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
+    return 3;
+  }
 }
 
 }  // namespace
@@ -152,7 +184,9 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--size", o->png_width, "PNG width in pixels")
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
-  command->add_option("--hidden", o->hidden, "show (remove: plot and render only)")
+  command
+      ->add_option("--hidden", o->hidden,
+                   "show (every line) or remove (only the visible pieces, streamed as curves)")
       ->check(CLI::IsMember({"show", "remove"}));
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
   command->add_flag("--no-pause", o->no_pause,
@@ -163,17 +197,8 @@ int RunStream(const StreamOptions& options) {
   // Messages name standard input "<stdin>", as the reader does.
   StreamOptions o = options;
   if (o.file == "-") o.file = "<stdin>";
-  if (o.hidden == "remove") {
-    throw InputError(
-        "--hidden remove: the device evaluates whole isolines itself, so stream cannot leave "
-        "their hidden parts out; draw the visible lines with `fdsurf plot --hidden remove` "
-        "(G-code, HPGL) instead");
-  }
-  const bool sim = o.device == "sim";
-  const bool usb = o.device == "usb" || o.device.rfind("usb:", 0) == 0;
-  const bool gpio = o.device.rfind("gpio:", 0) == 0;
-  const bool serial = o.device.rfind("serial:", 0) == 0;
-  if (!sim && !usb && !gpio && !serial) {
+  const bool sim = DeviceKindOf(o.device) == DeviceKind::kSim;
+  if (DeviceKindOf(o.device) == DeviceKind::kUnknown) {
     throw InputError("--device: '" + o.device +
                      "' is not sim, usb[:VID:PID|:BUS-PORT], serial:PATH[:BAUD], serial:auto or "
                      "gpio:CHIP:LINES");
@@ -194,16 +219,18 @@ int RunStream(const StreamOptions& options) {
   scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
   PlacePage(o.fit, o.origin, o.units, 1.0, set, &scaled);
   RefuseOutsideTravel(PlanPage(set, scaled, o.units), machine, scaled.origin);
-  const StreamJob job = BuildStreamJob(set, scaled, machine, o.units);
-  try {
-    if (sim) return RunSimulated(o, set, job, scaled, o.units);
-    if (usb) return RunUsb(o, job);
-    if (serial) return RunSerial(o, job);
-    return RunGpio(o, job);
-  } catch (const DeviceError& e) {
-    std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
-    return 3;
+  if (o.hidden == "remove") {
+    // The visible pieces, as plot draws them, streamed as the file's curves
+    // are; the sim checks the plotter against them.
+    const VisibleCurves visible = VisibleCurvesOf(set, scaled, machine, o.units);
+    if (!o.quiet) {
+      std::fprintf(stderr, "%s; %zu pieces drawn twice left out\n",
+                   DescribeHiddenLines(visible.report, visible.hidden, o.units).c_str(),
+                   visible.plan.duplicates_removed);
+    }
+    return StreamJobTo(o, visible.set, visible.options, visible.machine);
   }
+  return StreamJobTo(o, set, scaled, machine);
 }
 
 }  // namespace fdsurf::host

@@ -54,7 +54,8 @@ struct StreamOptions {
   std::string waveform;
   int png_width = 1600;
   bool quiet = false;
-  /// --hidden: only "show"; "remove" is refused (the device draws whole isolines).
+  /// --hidden: "show", or "remove": only the visible pieces of the lines,
+  /// streamed as Bézier curves (VisibleCurvesOf, stream.h).
   std::string hidden = "show";
   /// Do not wait for Enter between layers (the pen change); the runners
   /// also go on without waiting when stdin is not a terminal.

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/host/stream.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
+#include <string>
+#include <vector>
 
 #include "fdsurf/adaptive.h"
 #include "fdsurf/host/constructions.h"
@@ -502,6 +505,102 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     CheckAsTheDeviceWill<2>(job);
   }
   return job;
+}
+
+namespace {
+
+using StrokeCubic = std::array<std::array<double, 3>, 4>;
+
+// Whether a cubic's control points lie within `slack` of the segment from
+// its first to its last point: then every point of the curve lies on that
+// segment (convex hull) and the segment is all drawn, so one straight move
+// draws it.
+bool StraightCubic(const StrokeCubic& b, double slack) {
+  Vec chord{};
+  for (int c = 0; c < 3; ++c) chord[c] = b[3][c] - b[0][c];
+  const double length = Distance(b[0], b[3]);
+  if (length == 0) return false;
+  for (const std::size_t k : {std::size_t{1}, std::size_t{2}}) {
+    Vec from_start{};
+    for (int c = 0; c < 3; ++c) from_start[c] = b[k][c] - b[0][c];
+    const double along =
+        (from_start[0] * chord[0] + from_start[1] * chord[1] + from_start[2] * chord[2]) / length;
+    if (along < -slack || along > length + slack) return false;
+    Vec foot{};
+    for (int c = 0; c < 3; ++c) foot[c] = b[0][c] + chord[c] * (along / length);
+    if (Distance(b[k], foot) > slack) return false;
+  }
+  return true;
+}
+
+// The planned visible strokes as curves on the page, each cubic shifted by
+// `z_shift` along Z (3-D).
+std::vector<Curve> CurvesOfStrokes(const PatchSet& set, const Toolpath& path, double z_shift) {
+  std::vector<Curve> curves;
+  const double straight_slack = 1e-6 * path.quantum.value();
+  for (std::size_t k = 0; k < path.strokes.size(); ++k) {
+    const Stroke& stroke = path.strokes[k];
+    if (stroke.cubics.empty()) {
+      throw EngineError("hidden lines: visible piece " + std::to_string(k) +
+                        " has lost its exact cubics; it cannot be streamed as curves");
+    }
+    const std::string from = stroke.curve >= 0
+                                 ? set.curves[static_cast<std::size_t>(stroke.curve)].origin
+                                 : set.patches[stroke.patch].origin;
+    for (std::size_t j = 0; j < stroke.cubics.size(); ++j) {
+      Curve curve;
+      curve.basis = Basis::kBezier;
+      for (std::size_t i = 0; i < 4; ++i) {
+        curve.g[i] = stroke.cubics[j][i];
+        if (path.dims == 3) curve.g[i][2] += z_shift;
+      }
+      curve.layer = stroke.layer;
+      curve.straight = StraightCubic(stroke.cubics[j], straight_slack);
+      curve.origin =
+          "visible piece " + std::to_string(k) + "." + std::to_string(j) + ", from " + from;
+      curves.push_back(std::move(curve));
+    }
+  }
+  return curves;
+}
+
+}  // namespace
+
+VisibleCurves VisibleCurvesOf(const PatchSet& set, const ToolpathOptions& options,
+                              const MachineOptions& machine, const std::string& units) {
+  VisibleCurves out;
+  ToolpathOptions t = options;
+  t.quantum = machine.step;
+  t.mode = StepMode::kAdaptive;  // as plot draws; the samples of visibility
+  Toolpath path = BuildToolpath(set, t, units);
+  out.hidden = HiddenLineDefaults(t.tolerance);
+  out.report = RemoveHiddenLines(set, out.hidden, &path);
+  out.plan = PlanStrokes(set, &path);
+  if (path.strokes.empty()) throw InputError("--hidden remove: nothing of the drawing is visible");
+
+  out.set.units = units;
+  out.set.layers = set.layers;
+  out.set.page = std::array<double, 2>{path.width, path.height};
+  out.set.keep_order = true;  // PlanStrokes' order (nearest neighbour, 2-opt)
+  out.options = options;
+  out.options.view = *NamedView("top");
+  out.options.units_scale = 1;
+  out.options.origin = PageOrigin::kKeep;
+  out.options.fit.reset();
+  out.machine = machine;
+  out.set.curves = CurvesOfStrokes(set, path, 0);
+  if (t.dims == 3) {
+    // BuildStreamJob puts the bottom of a drawing at Z = 0, adding its
+    // depth: the whole drawing's (path.depth) for the whole drawing, the
+    // pieces' own for these. Shift the pieces by the difference, so that
+    // they end up where the whole drawing's job draws them, on its Z travel.
+    const double pieces_depth = PlanPage(out.set, out.options, units).depth;
+    out.set.curves = CurvesOfStrokes(set, path, path.depth - pieces_depth);
+    if (out.machine.travel[2] <= 0) {
+      out.machine.travel[2] = std::max(path.depth, machine.step.value());
+    }
+  }
+  return out;
 }
 
 namespace {

@@ -10,6 +10,8 @@
 // a piece is a point that was classified visible.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -262,6 +264,21 @@ HiddenLineReport RemoveHiddenLines(const PatchSet& set, const HiddenLineOptions&
   path->strokes = std::move(visible);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
+}
+
+std::string DescribeHiddenLines(const HiddenLineReport& report, const HiddenLineOptions& options,
+                                const std::string& units) {
+  const char* u = units.c_str();
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "hidden: %zu strokes -> %zu visible pieces; drawn %.1f -> %.1f %s; %zu points "
+                "tested in %.2f s (depth margin %s %s, cuts located within %s %s, samples at "
+                "most %s %s apart)",
+                report.strokes_before, report.strokes_after, report.length_before,
+                report.length_after, u, report.queries, report.seconds,
+                FormatNumber(options.eps).c_str(), u, FormatNumber(options.locate).c_str(), u,
+                FormatNumber(options.spacing).c_str(), u);
+  return line;
 }
 
 }  // namespace fdsurf::host

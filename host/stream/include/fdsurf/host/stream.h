@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_set.h"
+#include "fdsurf/host/plan.h"
 #include "fdsurf/host/toolpath.h"
 #include "fdsurf/protocol/messages.h"
 
@@ -89,6 +91,40 @@ struct StreamJob {
 /// range in `units`.
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
                          const MachineOptions& machine, const std::string& units);
+
+/// `fdsurf stream --hidden remove`: the visible pieces of a drawing as a
+/// flat drawing of Bézier curves, which BuildStreamJob(set, options,
+/// machine, units) streams like any file's curves (CURVE commands, straight
+/// pieces as MOVEs) and ReferenceLines compares with.
+struct VisibleCurves {
+  /// No patches; one Basis::kBezier curve per exact sub-cubic of a visible
+  /// piece (Stroke::cubics), in output units on the page of the whole
+  /// drawing (in 3-D, z placed so that the job of `set` puts every point at
+  /// the Z the whole drawing's job would), with the piece's layer; `straight` when its control
+  /// points lie within 10⁻⁶ steps of its chord. In the order PlanStrokes gives (shared edges drawn
+  /// once, pieces that meet joined), kept (keep_order); the page and the
+  /// layers of the drawing.
+  PatchSet set;
+  /// The options that draw `set` where the whole drawing would be drawn:
+  /// view top, origin keep, no scale, the page as set.page.
+  ToolpathOptions options;
+  /// The machine; in 3-D with the Z travel of the whole drawing unless given.
+  MachineOptions machine;
+  /// How visibility was decided (HiddenLineDefaults of the tolerance) and
+  /// what it removed; what planning joined and removed.
+  HiddenLineOptions hidden;
+  HiddenLineReport report;
+  PlanReport plan;
+};
+
+/// The drawing of `set` with `options` (as for BuildStreamJob) drawn as
+/// `fdsurf plot --hidden remove` draws it (adaptive steps, the quantum = one
+/// step), its hidden lines removed (RemoveHiddenLines), planned
+/// (PlanStrokes), and the visible pieces made curves. Throws as
+/// BuildToolpath and RemoveHiddenLines, and InputError when nothing is
+/// visible.
+VisibleCurves VisibleCurvesOf(const PatchSet& set, const ToolpathOptions& options,
+                              const MachineOptions& machine, const std::string& units);
 
 /// The isolines of the job as the exact (double) curves, in steps, sampled
 /// densely enough that the polyline is within `chord_steps` of the curve.
