@@ -6,10 +6,12 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
 #include <vector>
 
 #include "fdsurf/host/patch_io.h"
@@ -432,23 +434,103 @@ TEST_F(Cli, OriginKeepWritesTheFilesCoordinates) {
                 "--origin: 'middle' is not keep, center or min");
 }
 
-// A drawing below 0 under keep: G-code carries it as it is; an SVG page
-// (from 0) would cut it, and a machine's travel starts at 0: both refused.
-TEST_F(Cli, OriginKeepBelowZeroIsWrittenToGcodeAndRefusedForSvgAndStream) {
+// A drawing below 0 under keep: G-code carries it as it is, the SVG shows
+// more than the page so that nothing is cut off (and says so), and a
+// machine's travel starts at 0, so stream refuses it.
+TEST_F(Cli, OriginKeepBelowZeroIsWrittenToGcodeAndSvgAndRefusedForStream) {
   std::string text = kCurveJson;
   text.replace(text.find("[10, 10, 0]"), 11, "[-10, 10, 0]");
   const std::string file = Write("negative.json", text);
   const RunResult gcode = Run("plot '" + file + "' --view top --origin keep --format gcode -q");
   ASSERT_EQ(gcode.exit_code, 0) << gcode.err;
   EXPECT_EQ(FirstMove(gcode.out), "X-10.000 Y10.000");
+  // The page: 0 to the far edge plus the 5 mm margin, 45 x 35. The view
+  // grows left to x = -10 less half the 0.25 mm pen.
   const std::string svg = (dir_ / "negative.svg").string();
-  ExpectRefused("plot '" + file + "' --view top --origin keep -o '" + svg + "'",
-                "--origin keep: the drawing runs over x -10..40, y 10..30 mm, below the SVG/PNG "
-                "page's 0");
-  EXPECT_FALSE(fs::exists(svg));
+  const RunResult shown = Run("plot '" + file + "' --view top --origin keep -o '" + svg + "'");
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_NE(shown.err.find("fdsurf: note: the drawing runs past its 45 x 35 mm page; the SVG "
+                           "shows x -10.125..45.000, y 0.000..35.000 mm\n"),
+            std::string::npos)
+      << shown.err;
+  const std::string written = Slurp(svg);
+  EXPECT_NE(written.find(R"(width="55.125mm" height="35.000mm" viewBox="-10.125 0 55.125 35.000")"),
+            std::string::npos)
+      << written;
+  EXPECT_NE(written.find("M-10.000 25.000"), std::string::npos) << written;  // 35 - 10
   ExpectRefused("stream '" + file + "' --view top --origin keep",
                 "--origin keep: the drawing runs over x -10..40, y 10..30 mm, outside the "
                 "machine's travel x 0..45, y 0..35");
+}
+
+// An SVG whose drawing runs past its page on every side, as Inkscape's own
+// examples do (markers.svg: x -14.5..102.5 on a 100 mm page): the SVG and
+// the PNG show all of it at the file's coordinates.
+TEST_F(Cli, AnSvgPastItsPageIsShownWhole) {
+  // y_out = 100 - y_svg: the lines run x -10..110 at y 50, and y 108..-5
+  // at x 50; the view is that plus half the pen, 0.125 mm.
+  const std::string file = Write("cross.svg", R"(<svg xmlns="http://www.w3.org/2000/svg"
+    width="100mm" height="100mm" viewBox="0 0 100 100">
+    <path d="M -10 50 L 110 50 M 50 -8 L 50 105" stroke="black"/></svg>)");
+  const std::string svg = (dir_ / "cross-out.svg").string();
+  const std::string png = (dir_ / "cross.png").string();
+  // 481 px over the 120.25 mm view: 4 px per mm, 113.25 mm = 453 px high.
+  const RunResult r = Run("plot '" + file + "' -o '" + svg + "' --png '" + png + "' --size 481");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("fdsurf: note: the drawing runs past its 100 x 100 mm page; the SVG and "
+                       "the PNG show x -10.125..110.125, y -5.125..108.125 mm\n"),
+            std::string::npos)
+      << r.err;
+  // The viewBox's top is y' = 100 - 108.125: the points keep their places.
+  const std::string written = Slurp(svg);
+  EXPECT_NE(written.find(R"(width="120.250mm" height="113.250mm" viewBox="-10.125 -8.125 )"
+                         R"(120.250 113.250")"),
+            std::string::npos)
+      << written;
+  // The file's own ends (planning may draw a line either way).
+  for (const char* end : {"-10.000 50.000", "110.000 50.000", "50.000 -8.000", "50.000 105.000"}) {
+    EXPECT_NE(written.find(end), std::string::npos) << end << "\n" << written;
+  }
+  // The PNG's size from its IHDR chunk (big-endian width and height).
+  const std::string picture = Slurp(png);
+  ASSERT_GT(picture.size(), 24u);
+  const auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(picture[at + k]);
+    return v;
+  };
+  EXPECT_EQ(picture.substr(12, 4), "IHDR");
+  EXPECT_EQ(be32(16), 481u);
+  EXPECT_EQ(be32(20), 453u);
+  // --quiet leaves the note out too.
+  const RunResult quiet = Run("plot '" + file + "' -q -o '" + svg + "'");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+}
+
+// Headers and summaries count what the drawing holds: curves are not "0
+// patches".
+TEST_F(Cli, CountsSayCurvesForADrawingOfCurves) {
+  const std::string file = Write("curve.json", kCurveJson);
+  const RunResult gcode = Run("plot '" + file + "' --format gcode -q");
+  ASSERT_EQ(gcode.exit_code, 0) << gcode.err;
+  EXPECT_NE(gcode.out.find("; source: " + file + " (1 curve)\n"), std::string::npos) << gcode.out;
+  const RunResult teapot = Run("plot '" + kTeapot + "' --lines 2 --format gcode -q");
+  ASSERT_EQ(teapot.exit_code, 0) << teapot.err;
+  EXPECT_NE(teapot.out.find("; source: " + kTeapot + " (32 patches)\n"), std::string::npos);
+  // check: the overall line is the worst over the curves, named by its curve.
+  const RunResult check = Run("check '" + file + "' --grid 16");
+  ASSERT_EQ(check.exit_code, 0) << check.out << check.err;
+  const std::size_t at = check.out.find("overall: max error ");
+  ASSERT_NE(at, std::string::npos) << check.out;
+  const std::string overall = check.out.substr(at, check.out.find('\n', at) - at);
+  EXPECT_NE(overall.find(" in curve 0, 1 curve: within the 0.51-quantum bound"), std::string::npos)
+      << overall;
+  // The same worst error as the curves' own line prints.
+  const std::size_t curves = check.out.find("curves: max error ");
+  ASSERT_NE(curves, std::string::npos) << check.out;
+  EXPECT_EQ(check.out.substr(curves + 18, 8), overall.substr(19, 8)) << check.out;
+  EXPECT_GT(std::stod(overall.substr(19)), 0.0);
 }
 
 // One rule for both commands: the teapot (no page of its own) is centred on
@@ -511,8 +593,7 @@ TEST_F(Cli, DashReadsStandardInputForEveryCommand) {
   const RunResult stream =
       RunWithInput("stream - --view top --speed 400 --accel 10000 --pen-delay 5", json);
   ASSERT_EQ(stream.exit_code, 0) << stream.err;
-  EXPECT_NE(stream.err.find("<stdin>: 0 patches and 1 curves streamed"), std::string::npos)
-      << stream.err;
+  EXPECT_NE(stream.err.find("<stdin>: 1 curve streamed"), std::string::npos) << stream.err;
   // The format from the content, or --input-format; errors name <stdin>.
   const std::string empty = Write("empty", "  \n");
   const RunResult nothing = RunWithInput("plot -", empty);

@@ -7,7 +7,9 @@ usage: check_render.py STROKES.json --svg FILE.svg --hpgl FILE.hpgl
 - The SVG goes through rsvg-convert (librsvg) to a PNG at 100 dpi. The bounding
   box of its non-white pixels, in mm, must match the strokes' bounding box from
   STROKES.json. The SVG is y-down and fdsurf's coordinates are y-up, so y is
-  flipped with the page height.
+  flipped with the page height. The PNG shows the SVG's viewBox, which must
+  hold the page and may reach past it (a drawing kept at coordinates outside
+  its page); pixels are placed from the viewBox's origin.
 - The HPGL goes through Debian's hp2xx. The "Coordinate range" that hp2xx
   reports in plotter units (1/40 mm) must equal the strokes' bounding box.
   hp2xx also renders it true-size (-t) to a PBM bitmap at 100 dpi, and the
@@ -130,8 +132,23 @@ def near(what, got, want, slack):
         fail(f"{what}: renderer {got:.3f} mm, fdsurf {want:.3f} mm (allowed ±{slack:.3f})")
 
 
+def svg_view(svg):
+    """The root's viewBox: min-x, min-y, width, height (the output's units, y down)."""
+    with open(svg, encoding="utf-8") as f:
+        match = re.search(r'<svg[^>]*\sviewBox="([^"]*)"', f.read())
+    if not match:
+        fail(f"{svg}: no viewBox on the root")
+    return [float(v) for v in match.group(1).replace(",", " ").split()]
+
+
 def check_svg(svg, strokes, tmp):
     page = strokes["height"]
+    vx, vy, vw, vh = svg_view(svg)
+    eps = 1e-9
+    if vx > eps or vy > eps or vx + vw < strokes["width"] - eps or vy + vh < page - eps:
+        fail(f"{svg}: the viewBox {vx} {vy} {vw} {vh} does not hold the page "
+             f"{strokes['width']} x {page}")
+    left, top = vx, page - vy  # the drawing's coordinates of pixel (0, 0)'s corner
     x0, y0, x1, y1 = strokes["bbox"][0], strokes["bbox"][1], strokes["bbox"][-3 if strokes["dims"] == 3 else 2], \
         strokes["bbox"][-2 if strokes["dims"] == 3 else 3]
     png = os.path.join(tmp, "svg.png")
@@ -139,13 +156,14 @@ def check_svg(svg, strokes, tmp):
     width, height, rows = read_png(png)
     px0, py0, px1, py1 = drawn_box_png(rows)
     slack = PIXEL_MM + 0.125 + PIXEL_MM  # a pixel each way plus half the 0.25 mm pen
-    near(f"{svg}: page width", width * PIXEL_MM, strokes["width"], PIXEL_MM)
-    near(f"{svg}: left edge", px0 * PIXEL_MM, x0, slack)
-    near(f"{svg}: right edge", (px1 + 1) * PIXEL_MM, x1, slack)
-    near(f"{svg}: bottom edge", page - (py1 + 1) * PIXEL_MM, y0, slack)
-    near(f"{svg}: top edge", page - py0 * PIXEL_MM, y1, slack)
-    print(f"check_render: {svg}: rsvg-convert drew [{px0 * PIXEL_MM:.2f}, {page - (py1 + 1) * PIXEL_MM:.2f}]"
-          f"..[{(px1 + 1) * PIXEL_MM:.2f}, {page - py0 * PIXEL_MM:.2f}] mm, fdsurf [{x0}, {y0}]..[{x1}, {y1}] mm")
+    near(f"{svg}: view width", width * PIXEL_MM, vw, PIXEL_MM)
+    near(f"{svg}: left edge", left + px0 * PIXEL_MM, x0, slack)
+    near(f"{svg}: right edge", left + (px1 + 1) * PIXEL_MM, x1, slack)
+    near(f"{svg}: bottom edge", top - (py1 + 1) * PIXEL_MM, y0, slack)
+    near(f"{svg}: top edge", top - py0 * PIXEL_MM, y1, slack)
+    print(f"check_render: {svg}: rsvg-convert drew [{left + px0 * PIXEL_MM:.2f}, {top - (py1 + 1) * PIXEL_MM:.2f}]"
+          f"..[{left + (px1 + 1) * PIXEL_MM:.2f}, {top - py0 * PIXEL_MM:.2f}] mm, fdsurf [{x0}, {y0}]..[{x1}, {y1}] mm"
+          f" (viewBox {vx:g} {vy:g} {vw:g} {vh:g})")
 
 
 def check_hpgl(hpgl, strokes, tmp):

@@ -350,4 +350,14 @@ bool ShowProgress(bool quiet) {
   return !quiet && isatty(STDERR_FILENO) != 0 && std::getenv("CI") == nullptr;
 }
 
+std::string DescribeDrawing(std::size_t patches, std::size_t curves) {
+  const auto counted = [](std::size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  if (patches == 0 && curves == 0) return "no patches or curves";
+  if (curves == 0) return counted(patches, "patch", "patches");
+  if (patches == 0) return counted(curves, "curve", "curves");
+  return counted(patches, "patch", "patches") + " and " + counted(curves, "curve", "curves");
+}
+
 }  // namespace fdsurf::host

@@ -145,4 +145,8 @@ class StagedOutputs {
   std::vector<std::pair<std::string, std::string>> staged_;
 };
 
+/// What a drawing holds, for headers and summaries: "32 patches", "1 curve",
+/// "2 patches and 4 curves", "no patches or curves".
+std::string DescribeDrawing(std::size_t patches, std::size_t curves);
+
 }  // namespace fdsurf::host

@@ -40,7 +40,8 @@ void CurveSamples::Write(const std::function<void(const std::string&)>& out) con
   }
 }
 
-double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps) {
+double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps,
+                   std::size_t* worst_curve) {
   for (const std::string& note : set.notes) std::printf("note: %s\n", note.c_str());
   if (set.curves.empty()) return 0;
   std::vector<PreparedCurve<3>> prepared;
@@ -63,6 +64,7 @@ double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps) {
     });
     std::printf("%5zu  %3d  %4d  %5s  %18.6f  %u\n", c, prepared[c].format.acc_bits,
                 prepared[c].format.frac_bits, prepared[c].exact ? "yes" : "no", curve_worst, at);
+    if (curve_worst > worst && worst_curve != nullptr) *worst_curve = c;
     worst = std::max(worst, curve_worst);
   }
   std::printf("curves: max error %.6f quanta, %zu curves (%d steps each): %s\n", worst,

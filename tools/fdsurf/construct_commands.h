@@ -33,8 +33,10 @@ class CurveSamples {
 
 /// Prints the construction notes, then a table of the curves (if any)
 /// compared with their double evaluation. Returns the worst curve error in
-/// quanta (0 without curves).
-double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps);
+/// quanta (0 without curves), and the index of that curve in `worst_curve`
+/// when it is given.
+double CheckCurves(const PatchSet& set, const Quantum& quantum, int steps,
+                   std::size_t* worst_curve = nullptr);
 
 struct JoinsOptions {
   std::string file;

@@ -19,6 +19,9 @@ std::int64_t PageQuanta(double size, const Quantum& q) {
   return static_cast<std::int64_t>(std::ceil(q.ToQuanta(size) - 1e-9));
 }
 
+// The SVG's pen: 0.25 mm, or 0.01 in.
+double PenWidth(const std::string& units) { return units == "in" ? 0.01 : 0.25; }
+
 std::string XmlEscaped(const std::string& text) {
   std::string out;
   for (char c : text) {
@@ -292,13 +295,40 @@ class GcodeWriter {
 
 }  // namespace
 
+PageView ViewOfPage(const Toolpath& path) {
+  const Quantum& q = path.quantum;
+  const std::array<std::int64_t, 2> page{PageQuanta(path.width, q), PageQuanta(path.height, q)};
+  PageView view{{0, 0}, page, false};
+  std::array<std::int64_t, 2> lo{0, 0};
+  std::array<std::int64_t, 2> hi = page;
+  for (const Stroke& s : path.strokes) {
+    for (const auto& p : s.points) {
+      for (int c = 0; c < 2; ++c) {
+        lo[c] = std::min(lo[c], p[c]);
+        hi[c] = std::max(hi[c], p[c]);
+      }
+    }
+  }
+  // Half the pen beyond the outermost point, so that its line is whole too.
+  const std::int64_t half_pen = PageQuanta(PenWidth(path.units) / 2, q);
+  for (int c = 0; c < 2; ++c) {
+    if (lo[c] < 0) view.lo[c] = lo[c] - half_pen;
+    if (hi[c] > page[c]) view.hi[c] = hi[c] + half_pen;
+  }
+  view.past_page = view.lo[0] < 0 || view.lo[1] < 0 || view.hi != page;
+  return view;
+}
+
 std::string WriteSvg(const Toolpath& path, const std::string& title) {
   const Quantum& q = path.quantum;
-  const std::int64_t w = PageQuanta(path.width, q);
+  // User units are output units with y flipped at the page's top edge h,
+  // whatever the view: a point's coordinates do not depend on the view box.
   const std::int64_t h = PageQuanta(path.height, q);
-  const std::string width = q.Format(w);
-  const std::string height = q.Format(h);
-  const double pen = path.units == "in" ? 0.01 : 0.25;
+  const PageView view = ViewOfPage(path);
+  const std::string width = q.Format(view.hi[0] - view.lo[0]);
+  const std::string height = q.Format(view.hi[1] - view.lo[1]);
+  // The page alone keeps the "0 0 W H" it always had.
+  const auto origin = [&q](std::int64_t v) { return v == 0 ? std::string("0") : q.Format(v); };
   const bool layered = !path.layers.empty();
   std::ostringstream out;
   out << R"(<?xml version="1.0" encoding="UTF-8"?>)"
@@ -306,9 +336,10 @@ std::string WriteSvg(const Toolpath& path, const std::string& title) {
       << R"(<svg xmlns="http://www.w3.org/2000/svg" )"
       << (layered ? R"(xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" )" : "")
       << R"(version="1.1" width=")" << width << path.units << R"(" height=")" << height
-      << path.units << R"(" viewBox="0 0 )" << width << " " << height << "\">\n"
+      << path.units << R"(" viewBox=")" << origin(view.lo[0]) << " " << origin(h - view.hi[1])
+      << " " << width << " " << height << "\">\n"
       << "<title>" << XmlEscaped(title) << "</title>\n"
-      << R"(<g fill="none" stroke="black" stroke-width=")" << FormatNumber(pen)
+      << R"(<g fill="none" stroke="black" stroke-width=")" << FormatNumber(PenWidth(path.units))
       << R"(" stroke-linecap="round" stroke-linejoin="round">)"
       << "\n";
   int open_layer = -1;  // the layer group being written, -1 for none
@@ -406,8 +437,13 @@ std::string WriteStrokesJson(const Toolpath& path) {
 }
 
 void RenderPng(const Toolpath& path, int width_px, const std::string& file) {
-  const double scale = width_px / path.width;
-  const int height_px = std::max(1, static_cast<int>(std::ceil(path.height * scale)));
+  const double q = path.quantum.value();
+  const PageView view = ViewOfPage(path);
+  const std::int64_t wide = view.hi[0] - view.lo[0];
+  const std::int64_t high = view.hi[1] - view.lo[1];
+  const double scale = width_px / (static_cast<double>(wide) * q);  // pixels per unit
+  // The height in proportion, rounded up in integers (no ceil of 366.0000001).
+  const int height_px = std::max<int>(1, static_cast<int>((high * width_px + wide - 1) / wide));
   cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width_px, height_px);
   cairo_t* cr = cairo_create(surface);
   cairo_set_source_rgb(cr, 1, 1, 1);
@@ -416,11 +452,10 @@ void RenderPng(const Toolpath& path, int width_px, const std::string& file) {
   cairo_set_line_width(cr, std::max(1.0, width_px / 1200.0));
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  const double q = path.quantum.value();
   for (const Stroke& s : path.strokes) {
     for (std::size_t k = 0; k < s.points.size(); ++k) {
-      const double x = s.points[k][0] * q * scale;
-      const double y = height_px - s.points[k][1] * q * scale;
+      const double x = static_cast<double>(s.points[k][0] - view.lo[0]) * q * scale;
+      const double y = height_px - static_cast<double>(s.points[k][1] - view.lo[1]) * q * scale;
       if (k == 0) {
         cairo_move_to(cr, x, y);
       } else {

@@ -4,11 +4,15 @@
 // format's rules (docs/formats.md, "Output of fdsurf plot"): coordinates are
 // the exact decimals k·Q, SVG flips y to page height − y, G-code and JSON
 // keep y up, HPGL prints the whole plotter units themselves.
+#include <cairo.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,11 +72,13 @@ Toolpath ThreeDPath() {
 // ---- SVG
 
 TEST(WriteSvg, MillimetresFlipYIntoTheViewBox) {
-  // Page 10 mm = 10000 quanta → "10.000"; y' = 5000 − y.
+  // Page 10 mm = 10000 quanta → "10.000"; y' = 5000 − y. The point at
+  // x = −0.250 is left of the page: the view starts half the 0.25 mm pen
+  // (125 quanta) further left, at −0.375, and is 10.375 wide.
   const std::string expected =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"10.000mm\" "
-      "height=\"5.000mm\" viewBox=\"0 0 10.000 5.000\">\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"10.375mm\" "
+      "height=\"5.000mm\" viewBox=\"-0.375 0 10.375 5.000\">\n"
       "<title>two strokes</title>\n"
       "<g fill=\"none\" stroke=\"black\" stroke-width=\"0.25\" stroke-linecap=\"round\" "
       "stroke-linejoin=\"round\">\n"
@@ -85,10 +91,13 @@ TEST(WriteSvg, MillimetresFlipYIntoTheViewBox) {
 
 TEST(WriteSvg, InchesUseATenThousandthPenAndFourDecimals) {
   // Page 2.5 in = 25000 quanta of 0.0001 in; y' = 10000 − y; pen 0.01 in.
+  // The point at y = −0.0001 is below the page: the view reaches half the
+  // pen (50 quanta) lower, to y = −0.0051, so it is 1.0051 high; its top is
+  // still the page's, so the viewBox starts at y' = 0.
   const std::string expected =
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"2.5000in\" "
-      "height=\"1.0000in\" viewBox=\"0 0 2.5000 1.0000\">\n"
+      "height=\"1.0051in\" viewBox=\"0 0 2.5000 1.0051\">\n"
       "<title>in</title>\n"
       "<g fill=\"none\" stroke=\"black\" stroke-width=\"0.01\" stroke-linecap=\"round\" "
       "stroke-linejoin=\"round\">\n"
@@ -117,6 +126,95 @@ TEST(WriteSvg, EscapesTheTitleAndRoundsThePageUpToAWholeQuantum) {
       "</g>\n"
       "</svg>\n";
   EXPECT_EQ(WriteSvg(path, "a & <b> \"c\""), expected);
+}
+
+// A 4 × 3 mm page at 0.01 mm with a cross that runs past all four edges:
+// x −0.50..4.50 at y 1.00, and y −0.20..3.20 at x 2.00.
+Toolpath CrossPastThePage() {
+  Toolpath path;
+  path.units = "mm";
+  path.quantum = Quantum::Parse("0.01");
+  path.width = 4;
+  path.height = 3;
+  path.strokes.push_back(MakeStroke({{-50, 100, 0}, {450, 100, 0}}));
+  path.strokes.push_back(MakeStroke({{200, -20, 0}, {200, 320, 0}}));
+  return path;
+}
+
+TEST(ViewOfPage, IsThePageUnlessAPointLiesOutside) {
+  Toolpath path = CrossPastThePage();
+  // Half the 0.25 mm pen is 12.5 quanta of 0.01 mm, rounded up to 13.
+  PageView view = ViewOfPage(path);
+  EXPECT_EQ(view.lo, (std::array<std::int64_t, 2>{-63, -33}));
+  EXPECT_EQ(view.hi, (std::array<std::int64_t, 2>{463, 333}));
+  EXPECT_TRUE(view.past_page);
+  // Only past the top: only the top grows.
+  path.strokes = {MakeStroke({{0, 0, 0}, {400, 301, 0}})};
+  view = ViewOfPage(path);
+  EXPECT_EQ(view.lo, (std::array<std::int64_t, 2>{0, 0}));
+  EXPECT_EQ(view.hi, (std::array<std::int64_t, 2>{400, 314}));
+  EXPECT_TRUE(view.past_page);
+  // On the edges is on the page.
+  path.strokes = {MakeStroke({{0, 0, 0}, {400, 300, 0}})};
+  view = ViewOfPage(path);
+  EXPECT_EQ(view.lo, (std::array<std::int64_t, 2>{0, 0}));
+  EXPECT_EQ(view.hi, (std::array<std::int64_t, 2>{400, 300}));
+  EXPECT_FALSE(view.past_page);
+}
+
+TEST(WriteSvg, AViewPastEveryEdgeKeepsThePagesCoordinates) {
+  // View x −0.63..4.63, y −0.33..3.33 (ViewOfPage above): 5.26 × 3.66 mm.
+  // y' = 3.00 − y as on the page alone, so the viewBox's top is
+  // 3.00 − 3.33 = −0.33 and the points are the ones the page alone has.
+  const std::string expected =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"5.26mm\" "
+      "height=\"3.66mm\" viewBox=\"-0.63 -0.33 5.26 3.66\">\n"
+      "<title>cross</title>\n"
+      "<g fill=\"none\" stroke=\"black\" stroke-width=\"0.25\" stroke-linecap=\"round\" "
+      "stroke-linejoin=\"round\">\n"
+      "<path d=\"M-0.50 2.00 L4.50 2.00\"/>\n"
+      "<path d=\"M2.00 3.20 L2.00 -0.20\"/>\n"
+      "</g>\n"
+      "</svg>\n";
+  EXPECT_EQ(WriteSvg(CrossPastThePage(), "cross"), expected);
+}
+
+// The inked pixels' box of a PNG read back by cairo (libpng), as
+// {left, top, right, bottom}; anything not white is ink.
+std::array<int, 4> InkBox(cairo_surface_t* image) {
+  const int width = cairo_image_surface_get_width(image);
+  const int height = cairo_image_surface_get_height(image);
+  const int stride = cairo_image_surface_get_stride(image);
+  const unsigned char* data = cairo_image_surface_get_data(image);
+  std::array<int, 4> box{width, height, -1, -1};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      std::uint32_t pixel = 0;
+      std::memcpy(&pixel, data + static_cast<std::ptrdiff_t>(y) * stride + 4 * x, 4);
+      if ((pixel & 0xFFFFFFu) == 0xFFFFFFu) continue;
+      box = {std::min(box[0], x), std::min(box[1], y), std::max(box[2], x), std::max(box[3], y)};
+    }
+  }
+  return box;
+}
+
+TEST(RenderPng, ShowsTheSameViewAsTheSvg) {
+  // 526 px over the 526-quantum view: one pixel per quantum, 366 px high.
+  // Pixel x = x − (−63), pixel y = 366 − (y − (−33)): the horizontal line
+  // runs over x 13..513 at row 233, the vertical one over rows 13..353 at
+  // x 263; the 1 px round pen adds up to a pixel on each side.
+  const std::string file = ::testing::TempDir() + "/writers_test_cross.png";
+  RenderPng(CrossPastThePage(), 526, file);
+  cairo_surface_t* image = cairo_image_surface_create_from_png(file.c_str());
+  ASSERT_EQ(cairo_surface_status(image), CAIRO_STATUS_SUCCESS);
+  EXPECT_EQ(cairo_image_surface_get_width(image), 526);
+  EXPECT_EQ(cairo_image_surface_get_height(image), 366);
+  const std::array<int, 4> ink = InkBox(image);
+  cairo_surface_destroy(image);
+  std::remove(file.c_str());
+  const std::array<int, 4> drawn{13, 13, 513, 353};
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(ink[k], drawn[k], 1) << "side " << k;
 }
 
 // ---- G-code

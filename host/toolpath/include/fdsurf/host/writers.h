@@ -4,6 +4,8 @@
 // so that a caller can produce everything before it writes anything.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -12,9 +14,26 @@
 
 namespace fdsurf::host {
 
-/// SVG 1.1: a page of width × height output units (mm or in), one <path> per
-/// stroke, y flipped so that up in the drawing is up on the page. When the
-/// toolpath has layers, each run of strokes of one layer is an Inkscape
+/// What an SVG or PNG shows, in quanta of path.quantum, y up: the page
+/// [0, W] × [0, H] (W and H rounded up to whole quanta), grown on each side
+/// that a stroke's point lies beyond to that point plus half the SVG pen
+/// (0.25 mm or 0.01 in, rounded up to whole quanta), so that nothing drawn
+/// is cut off (docs/toolpaths.md, "The page").
+struct PageView {
+  std::array<std::int64_t, 2> lo{};
+  std::array<std::int64_t, 2> hi{};
+  /// The view is larger than the page: some point lies outside it.
+  bool past_page = false;
+};
+PageView ViewOfPage(const Toolpath& path);
+
+/// SVG 1.1: the view of ViewOfPage, as width × height output units (mm or
+/// in) and a viewBox in the same units, one <path> per stroke, y flipped at
+/// the page's top edge (H − y) so that up in the drawing is up on the page.
+/// A point's coordinates are the same whatever the view: a view that grows
+/// past the page only moves the viewBox's origin (negative past the left or
+/// the top edge). No page outline is drawn (a plotter would draw it). When
+/// the toolpath has layers, each run of strokes of one layer is an Inkscape
 /// layer group (<g inkscape:groupmode="layer" inkscape:label="NAME">).
 std::string WriteSvg(const Toolpath& path, const std::string& title);
 
@@ -71,7 +90,9 @@ std::string WriteHpgl(const Toolpath& path);
 /// points exactly as the other writers print them.
 std::string WriteStrokesJson(const Toolpath& path);
 
-/// Draws the strokes on a white page, `width_px` pixels wide, as a PNG file.
+/// Draws the strokes on white as a PNG file: the view of ViewOfPage,
+/// `width_px` pixels wide (the height in proportion, rounded up). Throws
+/// OutputError naming the file when it cannot be written.
 void RenderPng(const Toolpath& path, int width_px, const std::string& file);
 
 /// Writes `content` to `file`; throws OutputError naming the file.
