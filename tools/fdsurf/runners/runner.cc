@@ -9,6 +9,7 @@
 #include <regex>
 #include <string>
 
+#include "../cli_options.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/host/errors.h"
 #include "fdsurf/motion/path_generator.h"
@@ -182,12 +183,9 @@ std::string LayerLabel(const StreamJob& job, std::size_t command) {
 }
 
 std::string JobContents(const StreamJob& job) {
-  std::string what;
-  if (!job.patches.empty()) what = std::to_string(job.patches.size()) + " patches";
-  if (!job.curves.empty()) {
-    what += (what.empty() ? "" : " and ") + std::to_string(job.curves.size()) + " curves";
-  }
-  if (what.empty()) what = std::to_string(job.commands.size()) + " commands";
+  std::string what = job.patches.empty() && job.curves.empty()
+                         ? std::to_string(job.commands.size()) + " commands"
+                         : DescribeDrawing(job.patches.size(), job.curves.size());
   if (job.layers.size() > 1) what += " in " + std::to_string(job.layers.size()) + " layers";
   return what;
 }

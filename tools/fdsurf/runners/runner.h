@@ -55,7 +55,8 @@ std::size_t NextLayerBoundary(const StreamJob& job, std::size_t from);
 std::string LayerLabel(const StreamJob& job, std::size_t command);
 
 /// What the job draws, for the runners' summaries: "4 patches", "12 curves
-/// in 3 layers", "4 patches and 12 curves" ("N commands" when neither).
+/// in 3 layers", "4 patches and 12 curves" (DescribeDrawing; "N commands"
+/// when neither).
 std::string JobContents(const StreamJob& job);
 
 /// SIGINT and SIGTERM counted while it lives (the first is the runner's to

@@ -188,7 +188,7 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   for (const sim::DrawnPath& p : checked.drawn) points += p.points.size();
   const std::size_t command_bytes = CommandBytes(job);
   const std::size_t gcode_bytes = GcodeBytes(set, drawing, units);
-  const std::string what = DescribeDrawing(job.patches.size(), job.curves.size());
+  const std::string what = JobContents(job);
   std::fprintf(stderr,
                "%s: %s streamed to the simulated plotter (%u axes, %u Hz ticks); %zu shared edges "
                "drawn once\n",
