@@ -19,6 +19,8 @@ packages=(
   libcairo2-dev
   libusb-1.0-0-dev libgpiod-dev gpiod libserialport-dev
   python3 hp2xx librsvg2-bin
+  # The SVG reader's third-party check (tests/thirdparty/check_svg.py): inkscape --query-all.
+  inkscape
   # Microcontroller images under emulation (targets/README.md): the cross
   # compilers, QEMU (Cortex-M, RV32) and simavr with its library (AVR).
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib
