@@ -100,7 +100,8 @@ Program ReadProgram(const std::string& text) {
     const double f = Word(line, 'F', &has_f);
     if (has_x && has_y) {
       const std::array<double, 2> at{x * scale, y * scale};
-      if (line.rfind("G1", 0) == 0 && !p.points.empty()) p.segments.push_back({p.points.back(), at});
+      if (line.rfind("G1", 0) == 0 && !p.points.empty())
+        p.segments.push_back({p.points.back(), at});
       p.points.push_back(at);
     }
     if (has_z) p.z.insert(z * scale);
@@ -242,10 +243,10 @@ TEST_F(Units, PlotOptionsAgreeInBothUnits) {
     const char* inch;
   };
   const Case cases[] = {
-      {"--pen-up", "2.54", "0.1"},         {"--pen-down", "-1.27", "-0.05"},
-      {"--feed", "1270", "50"},            {"--plunge-feed", "254", "10"},
-      {"--travel-rate", "254", "10"},      {"--margin", "25.4", "1"},
-      {"--fit", "254x203.2", "10x8"},      {"--tolerance", "0.0254", "0.001"},
+      {"--pen-up", "2.54", "0.1"},        {"--pen-down", "-1.27", "-0.05"},
+      {"--feed", "1270", "50"},           {"--plunge-feed", "254", "10"},
+      {"--travel-rate", "254", "10"},     {"--margin", "25.4", "1"},
+      {"--fit", "254x203.2", "10x8"},     {"--tolerance", "0.0254", "0.001"},
       {"--quantum", "0.00254", "0.0001"},
   };
   for (const Case& c : cases) {
@@ -341,8 +342,8 @@ TEST_F(Units, StreamOptionsAgreeInBothUnits) {
   }
   EXPECT_EQ(summaries[1], summaries[0]);
   EXPECT_FALSE(waves[0].empty());
-  EXPECT_TRUE(waves[0] == waves[1]) << "the waveforms differ (" << waves[0].size() << " vs "
-                                    << waves[1].size() << " bytes)";
+  EXPECT_TRUE(waves[0] == waves[1])
+      << "the waveforms differ (" << waves[0].size() << " vs " << waves[1].size() << " bytes)";
 }
 
 }  // namespace

@@ -223,6 +223,27 @@ void AddGcodeFlavorOptions(CLI::App* command, PlotOptions* o) {
       ->check(CLI::PositiveNumber);
 }
 
+// --pen-up, --pen-down, --feed and --plunge-feed: in --units, the defaults
+// GcodeOptions' mm values converted (GcodeFor).
+void AddGcodeHeightAndFeedOptions(CLI::App* command, PlotOptions* o) {
+  const GcodeOptions mm;  // the defaults, in mm and mm/min
+  command->add_option("--pen-up", o->pen_up_z,
+                      "G-code Z with the pen up (also 3-D travel height), in --units " +
+                          DefaultInMmHelp(mm.pen_up_z, "mm"));
+  command->add_option(
+      "--pen-down", o->pen_down_z,
+      "G-code Z with the pen down, in --units " + DefaultInMmHelp(mm.pen_down_z, "mm"));
+  command
+      ->add_option("--feed", o->feed,
+                   "G-code drawing feed, --units per minute " + DefaultInMmHelp(mm.feed, "mm/min"))
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option(
+          "--plunge-feed", o->plunge_feed,
+          "G-code pen-down feed, --units per minute " + DefaultInMmHelp(mm.plunge_feed, "mm/min"))
+      ->check(CLI::PositiveNumber);
+}
+
 // --hidden remove: only the visible pieces of the lines, with the tolerances
 // stated on stderr.
 void RemoveHidden(const PlotOptions& o, const PatchSet& set, const ToolpathOptions& t,
@@ -342,23 +363,7 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
         ->check(CLI::IsMember({"z", "m3", "servo"}))
         ->capture_default_str();
     AddGcodeFlavorOptions(command, o);
-    const GcodeOptions mm;  // the defaults, in mm and mm/min
-    command->add_option("--pen-up", o->pen_up_z,
-                        "G-code Z with the pen up (also 3-D travel height), in --units " +
-                            DefaultInMmHelp(mm.pen_up_z, "mm"));
-    command->add_option(
-        "--pen-down", o->pen_down_z,
-        "G-code Z with the pen down, in --units " + DefaultInMmHelp(mm.pen_down_z, "mm"));
-    command
-        ->add_option(
-            "--feed", o->feed,
-            "G-code drawing feed, --units per minute " + DefaultInMmHelp(mm.feed, "mm/min"))
-        ->check(CLI::PositiveNumber);
-    command
-        ->add_option(
-            "--plunge-feed", o->plunge_feed,
-            "G-code pen-down feed, --units per minute " + DefaultInMmHelp(mm.plunge_feed, "mm/min"))
-        ->check(CLI::PositiveNumber);
+    AddGcodeHeightAndFeedOptions(command, o);
     command->add_option("--dwell", o->gcode.dwell, "G-code dwell after M3/M5, seconds")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();

@@ -108,6 +108,23 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
   }
 }
 
+// --step, --travel, --speed and --accel: in --units, the defaults
+// MachineOptions' mm values converted (Machine).
+void AddMachineOptions(CLI::App* command, StreamOptions* o) {
+  const MachineOptions mm;  // the defaults, in mm, mm/s and mm/s²
+  command->add_option("--step", o->step,
+                      "length of one motor step, in --units (default " + mm.step.Format(1) +
+                          " mm; for --units in " + DefaultStepIn(mm.step, "in").Format(1) +
+                          " in, the nearest with 9 decimals)");
+  command->add_option("--travel", o->travel,
+                      "machine travel WxH[xD] in --units (default: the page)");
+  command->add_option("--speed", o->speed_limit,
+                      "path speed limit, --units per second " + DefaultInMmHelp(mm.speed, "mm/s"));
+  command->add_option(
+      "--accel", o->accel_limit,
+      "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+}
+
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
@@ -129,24 +146,13 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
   AddPageOptions(command, &o->fit, &o->origin, &o->margin);
-  const MachineOptions mm;  // the defaults, in mm, mm/s and mm/s²
   command->add_option("--tolerance", o->tolerance,
                       "largest distance of the drawing from the exact curves, in --units " +
                           DefaultInMmHelp(ToolpathOptions{}.tolerance, "mm"));
   command->add_option("--dims", o->dims, "2 (pen plotter) or 3 (with Z, for CNC)")
       ->check(CLI::IsMember({2, 3}))
       ->capture_default_str();
-  command->add_option("--step", o->step,
-                      "length of one motor step, in --units (default " + mm.step.Format(1) +
-                          " mm; for --units in " + DefaultStepIn(mm.step, "in").Format(1) +
-                          " in, the nearest with 9 decimals)");
-  command->add_option("--travel", o->travel,
-                      "machine travel WxH[xD] in --units (default: the page)");
-  command->add_option("--speed", o->speed_limit,
-                      "path speed limit, --units per second " + DefaultInMmHelp(mm.speed, "mm/s"));
-  command->add_option(
-      "--accel", o->accel_limit,
-      "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+  AddMachineOptions(command, o);
   command->add_option("--pen-delay", o->pen_delay_ms, "rest after each pen change, milliseconds")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
