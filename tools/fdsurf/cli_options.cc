@@ -20,6 +20,7 @@
 #include "fdsurf/host/errors.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/svg_io.h"
+#include "fdsurf/host/text.h"
 
 namespace fdsurf::host {
 
@@ -105,6 +106,31 @@ double ParsePositive(const std::string& text, const std::string& what, bool allo
                      (allow_zero ? "zero or more" : "greater than zero"));
   }
   return value;
+}
+
+double MmPerUnit(const std::string& units) { return units == "in" ? 25.4 : 1.0; }
+
+double DefaultIn(double mm, const std::string& units) { return mm / MmPerUnit(units); }
+
+Quantum DefaultResolutionIn(const Quantum& mm, const std::string& units) {
+  if (units != "in") return mm;
+  // The largest 10^-k <= value: k = ceil(-log10(value)), nudged so that a
+  // value that is a power of ten itself keeps its k.
+  const double value = mm.value() / 25.4;
+  const int decimals = static_cast<int>(std::ceil(-std::log10(value) - 1e-9));
+  if (decimals < 1) return Quantum::Parse("1");
+  return Quantum::Parse("0." + std::string(static_cast<std::size_t>(decimals - 1), '0') + "1");
+}
+
+Quantum DefaultStepIn(const Quantum& mm, const std::string& units) {
+  if (units != "in") return mm;
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9f", mm.value() / 25.4);
+  return Quantum::Parse(text, "--step");
+}
+
+std::string DefaultInMmHelp(double mm, const std::string& unit) {
+  return "(default " + FormatNumber(mm) + " " + unit + "; converted for --units in)";
 }
 
 std::array<int, 2> ParseLines(const std::string& text) {
@@ -198,7 +224,9 @@ void AddPageOptions(CLI::App* command, std::string* fit, std::string* origin, st
                       "center (scaled to fit, centred) or min (scaled to fit, lower-left corner "
                       "at the margin); default: keep for a file with its own page or a G-code "
                       "program, center otherwise");
-  command->add_option("--margin", *margin, "space around the drawing (default 5 mm / 0.2 in)");
+  command->add_option(
+      "--margin", *margin,
+      "space around the drawing, in --units " + DefaultInMmHelp(kDefaultMarginMm, "mm"));
 }
 
 PageOrigin ParseOrigin(const std::string& text) {
@@ -209,8 +237,7 @@ PageOrigin ParseOrigin(const std::string& text) {
 }
 
 std::array<double, 2> DefaultPage(const std::string& units) {
-  return units == "in" ? std::array<double, 2>{200 / 25.4, 150 / 25.4}
-                       : std::array<double, 2>{200, 150};
+  return {DefaultIn(200, units), DefaultIn(150, units)};
 }
 
 void PlacePage(const std::string& fit, const std::string& origin, const std::string& units,

@@ -70,6 +70,32 @@ double ParseNumber(const std::string& text, const std::string& what);
 /// A number > 0 (or ≥ 0 with allow_zero); InputError naming `what` otherwise.
 double ParsePositive(const std::string& text, const std::string& what, bool allow_zero = false);
 
+/// Millimetres in one unit of --units ("mm" or "in"): 1, or 25.4 exactly.
+double MmPerUnit(const std::string& units);
+
+/// The space kept around a fitted drawing when --margin is left out, mm.
+constexpr double kDefaultMarginMm = 5;
+
+/// A default that carries a length (mm, mm/s, mm/s², mm/min) in `units`:
+/// mm / MmPerUnit(units), not rounded (only printing rounds it).
+double DefaultIn(double mm, const std::string& units);
+
+/// A default resolution (a quantum, given in mm) in `units`: itself in mm;
+/// in inches the largest power of ten no coarser than it (0.001 mm is
+/// 0.00001 in), so an inch job is never drawn coarser than the mm one and
+/// every bound in quanta stays exactly as derived for that quantum.
+Quantum DefaultResolutionIn(const Quantum& mm, const std::string& units);
+
+/// A default motor step (given in mm) in `units`: itself in mm; in inches
+/// the nearest value with 9 decimals, Quantum's limit (0.0125 mm is
+/// 0.000492126 in, 3.3e-8 relative: the step grid, and every bound in steps,
+/// is the inch one exactly; the drawing's physical size is off by 3.3e-8).
+Quantum DefaultStepIn(const Quantum& mm, const std::string& units);
+
+/// The help text's note of a default given in mm: "(default 5 mm; converted
+/// for --units in)", `unit` "mm", "mm/s", ...
+std::string DefaultInMmHelp(double mm, const std::string& unit);
+
 /// --lines: "U" or "UxV", each 0 (family left out) or 2..kMaxPatchSteps + 1.
 std::array<int, 2> ParseLines(const std::string& text);
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,15 @@ struct PlotOptions {
   /// --hidden: "show" (every line) or "remove" (hidden_lines.h).
   std::string hidden = "show";
   GcodeOptions gcode;
+  /// The G-code heights (--pen-up, --pen-down, in --units) and rates
+  /// (--feed, --plunge-feed, --travel-rate, --units per minute) as typed;
+  /// nullopt when left out: GcodeOptions' defaults, which are mm and mm/min,
+  /// converted to --units (GcodeFor, plot_command.cc).
+  std::optional<double> pen_up_z;
+  std::optional<double> pen_down_z;
+  std::optional<double> feed;
+  std::optional<double> plunge_feed;
+  std::optional<double> travel_rate;
 };
 
 struct PortsOptions {

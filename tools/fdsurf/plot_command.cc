@@ -67,7 +67,7 @@ std::string OutputFormat(const PlotOptions& o, bool render_only) {
 
 // Working units per --units unit (HPGL works in mm).
 double ToWork(const PlotOptions& o, const std::string& format) {
-  return format == "hpgl" && o.units == "in" ? 25.4 : 1.0;
+  return format == "hpgl" ? MmPerUnit(o.units) : 1.0;
 }
 
 // A drawing kept at its own coordinates may run past its page; the SVG and
@@ -94,7 +94,8 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   const double to_work = ToWork(o, format);
   *work_units = hpgl ? "mm" : o.units;
   ToolpathOptions t;
-  t.tolerance = to_work * (o.tolerance.empty() ? (o.units == "in" ? 0.002 : 0.05)
+  const ToolpathOptions mm;  // the library's defaults, in mm
+  t.tolerance = to_work * (o.tolerance.empty() ? DefaultIn(mm.tolerance, o.units)
                                                : ParsePositive(o.tolerance, "--tolerance"));
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
@@ -103,7 +104,7 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   // Checked before the file is read; PlacePage sets the page after.
   if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
   if (!o.origin.empty()) (void)ParseOrigin(o.origin);
-  t.margin = to_work * (o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0)
+  t.margin = to_work * (o.margin.empty() ? DefaultIn(kDefaultMarginMm, o.units)
                                          : ParsePositive(o.margin, "--margin", true));
   if (hpgl) {
     if (!o.quantum.empty() && o.quantum != "0.025") {
@@ -112,8 +113,8 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
     }
     t.quantum = Quantum::Parse("0.025");
   } else {
-    t.quantum = Quantum::Parse(
-        o.quantum.empty() ? (o.units == "in" ? "0.0001" : "0.001") : o.quantum, "--quantum");
+    t.quantum = o.quantum.empty() ? DefaultResolutionIn(mm.quantum, o.units)
+                                  : Quantum::Parse(o.quantum, "--quantum");
   }
   if (o.dims == 3 && format != "gcode" && format != "json") {
     throw InputError("--dims 3: only G-code and JSON carry a third axis");
@@ -123,6 +124,22 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
            : o.mode == "step-exact" ? StepMode::kStepExact
                                     : StepMode::kAdaptive;
   return t;
+}
+
+// The G-code options with the heights and rates as typed, or GcodeOptions'
+// defaults (mm, mm/min) in --units: a G-code job works in --units.
+GcodeOptions GcodeFor(const PlotOptions& o) {
+  const GcodeOptions mm;
+  const auto typed_or_default = [&](const std::optional<double>& typed, double default_mm) {
+    return typed ? *typed : DefaultIn(default_mm, o.units);
+  };
+  GcodeOptions g = o.gcode;
+  g.pen_up_z = typed_or_default(o.pen_up_z, mm.pen_up_z);
+  g.pen_down_z = typed_or_default(o.pen_down_z, mm.pen_down_z);
+  g.feed = typed_or_default(o.feed, mm.feed);
+  g.plunge_feed = typed_or_default(o.plunge_feed, mm.plunge_feed);
+  g.travel_rate = typed_or_default(o.travel_rate, mm.travel_rate);
+  return g;
 }
 
 // Counts of the drawing as drawn, before planning joins strokes.
@@ -182,7 +199,8 @@ void PrintSummary(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
 }
 
 // --flavor and the options that only some flavours use (docs/toolpaths.md).
-void AddGcodeFlavorOptions(CLI::App* command, GcodeOptions* g) {
+void AddGcodeFlavorOptions(CLI::App* command, PlotOptions* o) {
+  GcodeOptions* g = &o->gcode;
   command
       ->add_option("--flavor", g->flavor,
                    "G-code dialect: generic, grbl, marlin (G5, G4 P in ms, M280) or linuxcnc (G5)")
@@ -199,10 +217,31 @@ void AddGcodeFlavorOptions(CLI::App* command, GcodeOptions* g) {
       ->check(CLI::Range(0, 15))
       ->capture_default_str();
   command
-      ->add_option("--travel-rate", g->travel_rate,
-                   "G0 rate assumed by the time estimate, units per minute")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+      ->add_option("--travel-rate", o->travel_rate,
+                   "G0 rate assumed by the time estimate, --units per minute " +
+                       DefaultInMmHelp(GcodeOptions{}.travel_rate, "mm/min"))
+      ->check(CLI::PositiveNumber);
+}
+
+// --pen-up, --pen-down, --feed and --plunge-feed: in --units, the defaults
+// GcodeOptions' mm values converted (GcodeFor).
+void AddGcodeHeightAndFeedOptions(CLI::App* command, PlotOptions* o) {
+  const GcodeOptions mm;  // the defaults, in mm and mm/min
+  command->add_option("--pen-up", o->pen_up_z,
+                      "G-code Z with the pen up (also 3-D travel height), in --units " +
+                          DefaultInMmHelp(mm.pen_up_z, "mm"));
+  command->add_option(
+      "--pen-down", o->pen_down_z,
+      "G-code Z with the pen down, in --units " + DefaultInMmHelp(mm.pen_down_z, "mm"));
+  command
+      ->add_option("--feed", o->feed,
+                   "G-code drawing feed, --units per minute " + DefaultInMmHelp(mm.feed, "mm/min"))
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option(
+          "--plunge-feed", o->plunge_feed,
+          "G-code pen-down feed, --units per minute " + DefaultInMmHelp(mm.plunge_feed, "mm/min"))
+      ->check(CLI::PositiveNumber);
 }
 
 // --hidden remove: only the visible pieces of the lines, with the tolerances
@@ -226,7 +265,7 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) t.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
-  t.units_scale = file_units == work_units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
+  t.units_scale = file_units == work_units ? 1.0 : MmPerUnit(file_units) / MmPerUnit(work_units);
   PlacePage(o.fit, o.origin, o.units, ToWork(o, format), set, &t);
 
   const bool progress = ShowProgress(o.quiet);
@@ -248,7 +287,8 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   std::string content;
   if (format == "svg") content = WriteSvg(path, o.file + " drawn by fdsurf");
   if (format == "gcode") {
-    content = WriteGcode(path, o.gcode, GcodeHeader(o, set, t, path, work_units, counts.points));
+    content =
+        WriteGcode(path, GcodeFor(o), GcodeHeader(o, set, t, path, work_units, counts.points));
   }
   if (format == "hpgl") content = WriteHpgl(path);
   if (format == "json") content = WriteStrokesJson(path);
@@ -288,10 +328,9 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
   command->add_option("--size", o->png_width, "PNG width in pixels")
       ->check(CLI::Range(16, 20000))
       ->capture_default_str();
-  command->add_option(
-      "--tolerance", o->tolerance,
-      "largest distance of the drawing from the exact curves, in --units (default 0.05 mm / "
-      "0.002 in)");
+  command->add_option("--tolerance", o->tolerance,
+                      "largest distance of the drawing from the exact curves, in --units " +
+                          DefaultInMmHelp(ToolpathOptions{}.tolerance, "mm"));
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
       ->capture_default_str();
@@ -303,8 +342,11 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
       ->check(CLI::IsMember({"mm", "in"}))
       ->capture_default_str();
   AddPageOptions(command, &o->fit, &o->origin, &o->margin);
-  command->add_option("--quantum", o->quantum,
-                      "output resolution (default 0.001 mm / 0.0001 in; HPGL 0.025 mm)");
+  command->add_option(
+      "--quantum", o->quantum,
+      "output resolution, in --units (default " + ToolpathOptions{}.quantum.Format(1) +
+          " mm; for --units in the largest power of ten no coarser, " +
+          DefaultResolutionIn(ToolpathOptions{}.quantum, "in").Format(1) + " in; HPGL 0.025 mm)");
   command
       ->add_option("--mode", o->mode,
                    "adaptive, fixed (uniform steps) or step-exact (≤ 1 quantum per axis)")
@@ -320,19 +362,8 @@ void AddPlotOptions(CLI::App* command, PlotOptions* o, bool render_only) {
                      "M280 and a dwell)")
         ->check(CLI::IsMember({"z", "m3", "servo"}))
         ->capture_default_str();
-    AddGcodeFlavorOptions(command, &o->gcode);
-    command
-        ->add_option("--pen-up", o->gcode.pen_up_z,
-                     "G-code Z with the pen up (also 3-D travel height)")
-        ->capture_default_str();
-    command->add_option("--pen-down", o->gcode.pen_down_z, "G-code Z with the pen down")
-        ->capture_default_str();
-    command->add_option("--feed", o->gcode.feed, "G-code drawing feed, units per minute")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    command->add_option("--plunge-feed", o->gcode.plunge_feed, "G-code pen-down feed")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+    AddGcodeFlavorOptions(command, o);
+    AddGcodeHeightAndFeedOptions(command, o);
     command->add_option("--dwell", o->gcode.dwell, "G-code dwell after M3/M5, seconds")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();

@@ -18,7 +18,7 @@ namespace {
 
 ToolpathOptions DrawingOptions(const StreamOptions& o) {
   ToolpathOptions t;
-  t.tolerance = o.tolerance.empty() ? (o.units == "in" ? 0.002 : 0.05)
+  t.tolerance = o.tolerance.empty() ? DefaultIn(ToolpathOptions{}.tolerance, o.units)
                                     : ParsePositive(o.tolerance, "--tolerance");
   const auto lines = ParseLines(o.lines);
   t.lines_s = lines[0];
@@ -27,17 +27,16 @@ ToolpathOptions DrawingOptions(const StreamOptions& o) {
   // Checked before the file is read; PlacePage sets the page after.
   if (!o.fit.empty()) (void)ParsePage(o.fit, o.units);
   if (!o.origin.empty()) (void)ParseOrigin(o.origin);
-  t.margin =
-      o.margin.empty() ? (o.units == "in" ? 0.2 : 5.0) : ParsePositive(o.margin, "--margin", true);
+  t.margin = o.margin.empty() ? DefaultIn(kDefaultMarginMm, o.units)
+                              : ParsePositive(o.margin, "--margin", true);
   t.dims = o.dims;
   t.mode = StepMode::kStepExact;
   return t;
 }
 
 MachineOptions Machine(const StreamOptions& o) {
-  MachineOptions m;
-  m.step =
-      Quantum::Parse(o.step.empty() ? (o.units == "in" ? "0.0005" : "0.0125") : o.step, "--step");
+  MachineOptions m;  // the defaults, in mm, mm/s and mm/s²
+  m.step = o.step.empty() ? DefaultStepIn(m.step, o.units) : Quantum::Parse(o.step, "--step");
   if (!o.travel.empty()) {
     const std::size_t x1 = o.travel.find('x');
     const std::size_t x2 = x1 == std::string::npos ? x1 : o.travel.find('x', x1 + 1);
@@ -50,9 +49,9 @@ MachineOptions Machine(const StreamOptions& o) {
     if (x2 != std::string::npos)
       m.travel[2] = ParsePositive(o.travel.substr(x2 + 1), "--travel depth");
   }
-  if (!(o.speed > 0) || !(o.accel > 0)) throw InputError("--speed and --accel must be above 0");
-  m.speed = o.speed;
-  m.accel = o.accel;
+  m.speed = o.speed_limit ? *o.speed_limit : DefaultIn(m.speed, o.units);
+  m.accel = o.accel_limit ? *o.accel_limit : DefaultIn(m.accel, o.units);
+  if (!(m.speed > 0) || !(m.accel > 0)) throw InputError("--speed and --accel must be above 0");
   m.pen_delay_ms = o.pen_delay_ms;
   return m;
 }
@@ -109,6 +108,23 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
   }
 }
 
+// --step, --travel, --speed and --accel: in --units, the defaults
+// MachineOptions' mm values converted (Machine).
+void AddMachineOptions(CLI::App* command, StreamOptions* o) {
+  const MachineOptions mm;  // the defaults, in mm, mm/s and mm/s²
+  command->add_option("--step", o->step,
+                      "length of one motor step, in --units (default " + mm.step.Format(1) +
+                          " mm; for --units in " + DefaultStepIn(mm.step, "in").Format(1) +
+                          " in, the nearest with 9 decimals)");
+  command->add_option("--travel", o->travel,
+                      "machine travel WxH[xD] in --units (default: the page)");
+  command->add_option("--speed", o->speed_limit,
+                      "path speed limit, --units per second " + DefaultInMmHelp(mm.speed, "mm/s"));
+  command->add_option(
+      "--accel", o->accel_limit,
+      "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+}
+
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
@@ -131,18 +147,12 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->capture_default_str();
   AddPageOptions(command, &o->fit, &o->origin, &o->margin);
   command->add_option("--tolerance", o->tolerance,
-                      "largest distance of the drawing from the exact curves (default 0.05 mm / "
-                      "0.002 in)");
+                      "largest distance of the drawing from the exact curves, in --units " +
+                          DefaultInMmHelp(ToolpathOptions{}.tolerance, "mm"));
   command->add_option("--dims", o->dims, "2 (pen plotter) or 3 (with Z, for CNC)")
       ->check(CLI::IsMember({2, 3}))
       ->capture_default_str();
-  command->add_option("--step", o->step,
-                      "length of one motor step (default 0.0125 mm / 0.0005 in)");
-  command->add_option("--travel", o->travel, "machine travel WxH[xD] (default: the page)");
-  command->add_option("--speed", o->speed, "path speed limit, units per second")
-      ->capture_default_str();
-  command->add_option("--accel", o->accel, "path acceleration limit, units per second²")
-      ->capture_default_str();
+  AddMachineOptions(command, o);
   command->add_option("--pen-delay", o->pen_delay_ms, "rest after each pen change, milliseconds")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
@@ -212,11 +222,13 @@ int RunStream(const StreamOptions& options) {
   }
   ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
+  o.speed = machine.speed;  // for the runners' summaries
+  o.accel = machine.accel;
   const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;
   ToolpathOptions scaled = drawing;
-  scaled.units_scale = file_units == o.units ? 1.0 : (file_units == "in" ? 25.4 : 1 / 25.4);
+  scaled.units_scale = file_units == o.units ? 1.0 : MmPerUnit(file_units) / MmPerUnit(o.units);
   PlacePage(o.fit, o.origin, o.units, 1.0, set, &scaled);
   RefuseOutsideTravel(PlanPage(set, scaled, o.units), machine, scaled.origin);
   if (o.hidden == "remove") {

@@ -4,6 +4,7 @@
 // and reports what happened.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "cli_options.h"
@@ -33,8 +34,14 @@ struct StreamOptions {
   // The machine.
   std::string step;
   std::string travel;
-  double speed = 100;
-  double accel = 2000;
+  /// Path speed (--units per second) and acceleration (per second²) limits
+  /// as typed; nullopt when left out: MachineOptions' defaults, which are
+  /// mm/s and mm/s², converted to --units.
+  std::optional<double> speed_limit;
+  std::optional<double> accel_limit;
+  /// The limits in effect, in --units: set by RunStream for the runners.
+  double speed = 0;
+  double accel = 0;
   int pen_delay_ms = 100;
   std::uint32_t tick_hz = 0;
   // The link and the simulator.

@@ -20,7 +20,9 @@
 
 namespace fdsurf::host {
 
-/// The machine, in output units (mm or in) and seconds.
+/// The machine, in output units (mm or in) and seconds. The defaults are in
+/// mm (mm/s, mm/s²); a caller working in inches converts them (fdsurf stream
+/// does, stream_command.cc).
 struct MachineOptions {
   /// Length of one motor step; every position is a whole number of steps.
   Quantum step = Quantum::Parse("0.0125");

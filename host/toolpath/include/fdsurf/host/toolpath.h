@@ -68,7 +68,8 @@ enum class PageOrigin {
 
 struct ToolpathOptions {
   /// Largest distance between the drawn polyline and the exact curve, in
-  /// output units (Euclidean, in the output's 2 or 3 dimensions).
+  /// output units (Euclidean, in the output's 2 or 3 dimensions). The
+  /// default, and the quantum's, are mm; fdsurf converts them for inches.
   double tolerance = 0.05;
   /// Isolines per patch along each family (s-lines: s fixed; t-lines: t
   /// fixed), each ≥ 2, or 0 to leave the family out.

@@ -44,6 +44,8 @@ struct GcodeOptions {
   /// "z": pen up/down (or the plunge in 3-D) as Z moves; "m3": M3/M5 with a
   /// dwell; "servo": Marlin's M280 P<servo_index> S<angle> with a dwell.
   std::string pen = "z";
+  /// Z heights, output units. These and the rates below default to mm and
+  /// mm/min; a caller working in inches converts them (fdsurf plot does).
   double pen_up_z = 5;
   double pen_down_z = 0;
   /// Servo angles (degrees) for the pen up and down, and the servo's index.
