@@ -44,7 +44,7 @@ struct Targets {
   }
 
   // The built-in default of `flag`, "(built in)" when it depends on others.
-  std::string DefaultOf(const std::string& flag) const {
+  FDSURF_NODISCARD std::string DefaultOf(const std::string& flag) const {
     for (const CLI::App* command : {stream, plot}) {
       const CLI::Option* option = command->get_option_no_throw(flag);
       if (option != nullptr && !option->get_default_str().empty()) {

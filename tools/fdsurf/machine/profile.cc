@@ -274,7 +274,7 @@ MachineProfile ParseMachineProfile(std::string_view text, const std::string& pat
     if (key == &MachineKeys().front()) {
       if (value.text != "mm" && value.text != "in") {
         throw KeyError(path, node.source(), key->name,
-                       "must be \"mm\" or \"in\", not \"" + value.text + "\"");
+                       R"(must be "mm" or "in", not ")" + value.text + "\"");
       }
       profile.units = value.text;
       continue;
@@ -338,9 +338,11 @@ void ApplyMachineProfile(const MachineProfile& profile, CLI::App* command) {
     if (option == nullptr || option->count() > 0) continue;
     const std::string text = OptionText(profile, value, units);
     const auto refuse = [&](const std::string& why) {
-      return InputError(profile.path + ":" + std::to_string(value.line) + ":" +
-                        std::to_string(value.column) + ": key '" + value.key->name + "' (" + text +
-                        UnitText(*value.key, units) + " for " + value.key->option + "): " + why);
+      std::string message = profile.path + ":" + std::to_string(value.line) + ":" +
+                            std::to_string(value.column) + ": key '" + value.key->name + "' (";
+      message += text + UnitText(*value.key, units) + " for " + value.key->option + "): ";
+      message += why;
+      return InputError(message);
     };
     try {
       if (value.key->check == KeyCheck::kQuantum) (void)Quantum::Parse(text, value.key->option);

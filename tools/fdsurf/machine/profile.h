@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
+
 namespace CLI {
 class App;
 }
@@ -65,7 +67,7 @@ struct MachineProfile {
   std::vector<ProfileValue> values;
 
   /// The value of `key`, or nullptr when the profile leaves it out.
-  const ProfileValue* Find(std::string_view key) const;
+  FDSURF_NODISCARD const ProfileValue* Find(std::string_view key) const;
 };
 
 /// The file `--machine NAME_OR_FILE` names: FILE when it holds a '/' or ends
@@ -74,11 +76,11 @@ struct MachineProfile {
 /// Base Directory spec says). Throws InputError naming where it looked.
 std::string FindMachineProfile(const std::string& name_or_file);
 
-/// Parses `toml` (the text of `path`). Throws InputError
+/// Parses `text` (the TOML of `path`). Throws InputError
 /// "PATH:LINE:COLUMN: ..." for a TOML syntax error, a key not in the schema
 /// (with the nearest known key, or "not supported yet"), a value of the
 /// wrong type or out of range.
-MachineProfile ParseMachineProfile(std::string_view toml, const std::string& path);
+MachineProfile ParseMachineProfile(std::string_view text, const std::string& path);
 
 /// Reads and parses the file at `path` (InputError when it cannot be read).
 MachineProfile LoadMachineProfile(const std::string& path);
