@@ -173,6 +173,20 @@ TEST(MachineProfile, TheOptionsOwnChecksApplyWithThePosition) {
   EXPECT_EQ(ApplyRefusal("dims = 4\n", {"--dims", "2"}), "");
 }
 
+TEST(MachineProfile, LengthsAreRefusedWhileTheCommandsUnitsAreUnknown) {
+  CLI::App app;
+  std::string units;  // no default: the units would come from the drawing
+  double speed = 100;
+  int pen_delay = 100;
+  app.add_option("--units", units);
+  app.add_option("--speed", speed);
+  app.add_option("--pen-delay", pen_delay);
+  app.parse(std::vector<std::string>{});
+  EXPECT_THROW(ApplyMachineProfile(ParseMachineProfile("speed = 3\n", "m.toml"), &app), InputError);
+  ApplyMachineProfile(ParseMachineProfile("pen_delay = 30\n", "m.toml"), &app);
+  EXPECT_EQ(pen_delay, 30);  // not a length: nothing to convert
+}
+
 // HOME and XDG_CONFIG_HOME pointed at a scratch folder for one test.
 class MachineLookup : public ::testing::Test {
  protected:

@@ -145,6 +145,11 @@ std::string FormatOptionNumber(double v) {
   return text;
 }
 
+// Whether the key's figures are lengths, converted between mm and in.
+bool IsLength(const MachineKey& key) {
+  return key.type == KeyType::kLength || key.type == KeyType::kLengthList;
+}
+
 }  // namespace
 
 const std::vector<MachineKey>& MachineKeys() {
@@ -299,9 +304,9 @@ std::string OptionText(const MachineProfile& profile, const ProfileValue& value,
                        const std::string& command_units) {
   const MachineKey& key = *value.key;
   if (key.type == KeyType::kText || key.type == KeyType::kInteger) return value.text;
-  const bool length = key.type == KeyType::kLength || key.type == KeyType::kLengthList;
   double scale = 1;
-  if (length && profile.units != command_units) scale = profile.units == "in" ? 25.4 : 1 / 25.4;
+  if (IsLength(key) && profile.units != command_units)
+    scale = profile.units == "in" ? 25.4 : 1 / 25.4;
   std::string text;
   for (const double n : value.numbers) {
     if (!text.empty()) text += "x";
@@ -336,6 +341,11 @@ void ApplyMachineProfile(const MachineProfile& profile, CLI::App* command) {
   for (const ProfileValue& value : profile.values) {
     CLI::Option* option = command->get_option_no_throw(value.key->option);
     if (option == nullptr || option->count() > 0) continue;
+    if (IsLength(*value.key) && units != "mm" && units != "in") {
+      // Converting into units not known yet would guess: refuse instead.
+      throw InputError(profile.path + ":" + std::to_string(value.line) + ": key '" +
+                       value.key->name + "': the command's units are not known yet; give --units");
+    }
     const std::string text = OptionText(profile, value, units);
     const auto refuse = [&](const std::string& why) {
       std::string message = profile.path + ":" + std::to_string(value.line) + ":" +
