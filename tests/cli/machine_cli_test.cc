@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "tool_run.h"
@@ -29,6 +31,30 @@ class MachineCli : public ToolTest {
     }
     return text;
   }
+};
+
+// Sets (or, for nullptr, unsets) an environment variable the tool inherits,
+// until the end of the scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    const char* before = std::getenv(name);
+    had_ = before != nullptr;
+    if (had_) before_ = before;
+    if (value != nullptr) ::setenv(name, value, 1);
+    if (value == nullptr) ::unsetenv(name);
+  }
+  ~ScopedEnv() {
+    if (had_) ::setenv(name_.c_str(), before_.c_str(), 1);
+    if (!had_) ::unsetenv(name_.c_str());
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::string before_;
+  bool had_ = false;
 };
 
 // sim.toml's settings, as flags.
@@ -103,14 +129,23 @@ TEST_F(MachineCli, ProfileIsFoundByNameUnderXdgConfigHome) {
   Write("mine.toml", "speed = 42\n");
   std::filesystem::create_directories(dir_ / "config" / "fdsurf" / "machines");
   std::filesystem::rename(dir_ / "mine.toml", dir_ / "config/fdsurf/machines/mine.toml");
-  const char* saved = std::getenv("XDG_CONFIG_HOME");
-  const std::string before = saved == nullptr ? "" : saved;
-  ::setenv("XDG_CONFIG_HOME", (dir_ / "config").c_str(), 1);
+  const ScopedEnv xdg("XDG_CONFIG_HOME", (dir_ / "config").c_str());
   const RunResult r = Run("machine show --machine mine");
-  if (saved == nullptr) ::unsetenv("XDG_CONFIG_HOME");
-  if (saved != nullptr) ::setenv("XDG_CONFIG_HOME", before.c_str(), 1);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("profile " + (dir_ / "config/fdsurf/machines/mine.toml").string() + ":1"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(MachineCli, ProfileUnderHomeConfigIsShownWithATilde) {
+  std::filesystem::create_directories(dir_ / ".config" / "fdsurf" / "machines");
+  std::ofstream(dir_ / ".config/fdsurf/machines/mine.toml") << "\nspeed = 42\n";
+  const ScopedEnv home("HOME", dir_.string().c_str());
+  const ScopedEnv xdg("XDG_CONFIG_HOME", nullptr);
+  const RunResult r = Run("machine show --machine mine");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("42                   mm/s       --speed        profile "
+                       "~/.config/fdsurf/machines/mine.toml:2"),
             std::string::npos)
       << r.out;
 }

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "../commands.h"
@@ -55,6 +56,14 @@ struct Targets {
   }
 };
 
+// `path` with $HOME written as "~", as a user would type it.
+std::string ForShow(const std::string& path) {
+  const char* home = std::getenv("HOME");
+  if (home == nullptr || home[0] == '\0') return path;
+  const std::string prefix = std::string(home) + "/";
+  return path.rfind(prefix, 0) == 0 ? "~/" + path.substr(prefix.size()) : path;
+}
+
 }  // namespace
 
 void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
@@ -82,7 +91,8 @@ int RunMachineShow(const MachineShowOptions& options) {
     profile = LoadMachineProfile(FindMachineProfile(options.machine));
     ApplyMachineProfile(profile, targets.stream);
     ApplyMachineProfile(profile, targets.plot);
-    std::printf("profile %s (its lengths in %s)\n", profile.path.c_str(), profile.units.c_str());
+    std::printf("profile %s (its lengths in %s)\n", ForShow(profile.path).c_str(),
+                profile.units.c_str());
   } else {
     std::printf("no profile (--machine NAME|FILE)\n");
   }
@@ -99,7 +109,7 @@ int RunMachineShow(const MachineShowOptions& options) {
       source = "command line";
     } else if (in_profile != nullptr) {
       value = OptionText(profile, *in_profile, units);
-      source = "profile " + SourceOf(profile, *in_profile);
+      source = "profile " + ForShow(SourceOf(profile, *in_profile));
     } else {
       value = targets.DefaultOf(key.option);
       source = "default";
