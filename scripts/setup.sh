@@ -10,6 +10,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
+  # Machine profiles (docs/machines.md).
+  libtomlplusplus-dev
   # The SVG reader.
   libpugixml-dev
   clang-format clang-tidy

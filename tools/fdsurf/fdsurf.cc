@@ -12,6 +12,8 @@
 #include "construct_commands.h"
 #include "fdsurf/host/errors.h"
 #include "fdsurf_version.h"
+#include "machine/machine_command.h"
+#include "machine/profile.h"
 #include "stream_command.h"
 
 namespace fdsurf::host {
@@ -26,6 +28,10 @@ struct Commands {
   StreamOptions stream_options;
   JoinsOptions joins_options;
   PortsOptions ports_options;
+  MachineShowOptions machine_show_options;
+  /// --machine of stream and plot (machine/profile.h).
+  std::string stream_machine;
+  std::string plot_machine;
   CLI::App* sample = nullptr;
   CLI::App* check = nullptr;
   CLI::App* plot = nullptr;
@@ -33,6 +39,8 @@ struct Commands {
   CLI::App* stream = nullptr;
   CLI::App* joins = nullptr;
   CLI::App* ports = nullptr;
+  CLI::App* machine = nullptr;
+  CLI::App* machine_show = nullptr;
 };
 
 void AddCommands(CLI::App* app, Commands* c) {
@@ -52,6 +60,7 @@ void AddCommands(CLI::App* app, Commands* c) {
       "plot",
       "Draw the patches as a wireframe of isolines for a plotter or CNC: SVG, G-code, HPGL.");
   AddPlotOptions(c->plot, &c->plot_options, false);
+  AddMachineOption(c->plot, &c->plot_machine);
   c->render = app->add_subcommand("render", "Draw the patches' isolines as a PNG picture.");
   AddPlotOptions(c->render, &c->render_options, true);
   c->stream = app->add_subcommand(
@@ -59,6 +68,7 @@ void AddCommands(CLI::App* app, Commands* c) {
       "Stream the patches to a plotter (default: the simulated one), which evaluates them by "
       "forward differences and draws them; report what it drew.");
   AddStreamOptions(c->stream, &c->stream_options);
+  AddMachineOption(c->stream, &c->stream_machine);
   c->joins = app->add_subcommand(
       "joins", "Report for every shared edge of the patches whether the join is C0, G1 or C1.");
   AddJoinsOptions(c->joins, &c->joins_options);
@@ -67,6 +77,11 @@ void AddCommands(CLI::App* app, Commands* c) {
       "List the serial ports (USB VID:PID, serial number, product); --probe asks each "
       "for the fdsurf firmware.");
   AddPortsOptions(c->ports, &c->ports_options);
+  c->machine = app->add_subcommand("machine", "Machine profiles (docs/machines.md).");
+  c->machine->require_subcommand(1);
+  c->machine_show = c->machine->add_subcommand(
+      "show", "Print the effective machine settings and where each came from.");
+  AddMachineShowOptions(c->machine_show, &c->machine_show_options);
 }
 
 // CLI11 would only say "a subcommand is required" for a mistyped command.
@@ -74,13 +89,16 @@ bool IsUnknownCommand(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return false;
   const std::string first = argv[1];
   return first != "sample" && first != "check" && first != "plot" && first != "render" &&
-         first != "stream" && first != "joins" && first != "ports";
+         first != "stream" && first != "joins" && first != "ports" && first != "machine";
 }
 
 // Runs the parsed command; the library's errors become messages and exit
-// codes (2 bad input or output, 3 the engine refused).
-int RunParsed(const Commands& c) {
+// codes (2 bad input or output, 3 the engine refused). A --machine profile
+// fills in the options the command line left out before anything runs.
+int RunParsed(Commands& c) {
   try {
+    if (c.plot->parsed()) ApplyMachineOption(c.plot_machine, c.plot);
+    if (c.stream->parsed()) ApplyMachineOption(c.stream_machine, c.stream);
     if (c.sample->parsed()) return RunSample(c.sample_options);
     if (c.check->parsed()) return RunCheck(c.check_options);
     if (c.plot->parsed()) return RunPlot(c.plot_options, false);
@@ -88,6 +106,7 @@ int RunParsed(const Commands& c) {
     if (c.stream->parsed()) return RunStream(c.stream_options);
     if (c.joins->parsed()) return RunJoins(c.joins_options);
     if (c.ports->parsed()) return RunPorts(c.ports_options);
+    if (c.machine_show->parsed()) return RunMachineShow(c.machine_show_options);
   } catch (const OptionError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.MessageFor(FlagFor(e.field())).c_str());
     return 2;
@@ -117,7 +136,7 @@ int Main(int argc, char** argv) {
     std::fprintf(
         stderr,
         "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream, "
-        "joins or ports)\n",
+        "joins, ports or machine)\n",
         argv[1]);
     return 2;
   }

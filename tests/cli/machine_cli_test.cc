@@ -1,0 +1,169 @@
+// SPDX-License-Identifier: MIT
+// Machine profiles through the tool (docs/machines.md): stream and plot with
+// --machine do what the same settings as flags do, the command line beats
+// the profile, `machine show` names where each setting came from, a profile
+// is found by name under XDG_CONFIG_HOME, and a bad one stops the command
+// with exit 2 before anything is drawn.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tool_run.h"
+
+namespace fdsurf::test_support {
+namespace {
+
+const std::string kTeapot = std::string(FDSURF_EXAMPLES_DIR) + "/teapot.bpt";
+const std::string kMachines = std::string(FDSURF_EXAMPLES_DIR) + "/machines";
+
+class MachineCli : public ToolTest {
+ protected:
+  MachineCli() : ToolTest("fdsurf_machine_cli_") {}
+
+  // `text` with every occurrence of `from` replaced by `to`.
+  static std::string Replace(std::string text, const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+      text.replace(at, from.size(), to);
+      at += to.size();
+    }
+    return text;
+  }
+};
+
+// Sets (or, for nullptr, unsets) an environment variable the tool inherits,
+// until the end of the scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    const char* before = std::getenv(name);
+    had_ = before != nullptr;
+    if (had_) before_ = before;
+    if (value != nullptr) ::setenv(name, value, 1);
+    if (value == nullptr) ::unsetenv(name);
+  }
+  ~ScopedEnv() {
+    if (had_) ::setenv(name_.c_str(), before_.c_str(), 1);
+    if (!had_) ::unsetenv(name_.c_str());
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::string name_;
+  std::string before_;
+  bool had_ = false;
+};
+
+// sim.toml's settings, as flags.
+const char* const kSimFlags =
+    " --device sim --dims 2 --step 0.0125 --travel 300x200 --speed 80 --accel 1500"
+    " --pen-delay 50 --tick-hz 40000";
+
+TEST_F(MachineCli, StreamWithTheSimProfileDrawsWhatTheSameFlagsDraw) {
+  const std::string drawing = "stream '" + kTeapot + "' --fit 240x160 --lines 3 --svg ";
+  const std::string a = (dir_ / "profile.svg").string();
+  const std::string b = (dir_ / "flags.svg").string();
+  const std::string c = (dir_ / "defaults.svg").string();
+  const RunResult profile = Run(drawing + "'" + a + "' --machine '" + kMachines + "/sim.toml'");
+  const RunResult flags = Run(drawing + "'" + b + "'" + kSimFlags);
+  const RunResult defaults = Run(drawing + "'" + c + "'");
+  ASSERT_EQ(profile.exit_code, 0) << profile.err;
+  ASSERT_EQ(flags.exit_code, 0) << flags.err;
+  EXPECT_EQ(Replace(profile.err, a, b), flags.err);
+  EXPECT_EQ(Slurp(a), Slurp(b));
+  EXPECT_NE(profile.err.find("motion limits (80 mm/s, 1500 mm/s², pen delay 50 ms)"),
+            std::string::npos)
+      << profile.err;
+  // Without the profile the report differs: the comparison above can fail.
+  EXPECT_NE(Replace(defaults.err, c, b), flags.err);
+}
+
+TEST_F(MachineCli, CommandLineBeatsTheProfile) {
+  const RunResult r = Run("stream '" + kTeapot + "' --fit 240x160 --lines 2 --machine '" +
+                          kMachines + "/sim.toml' --speed 60 --pen-delay 20");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("motion limits (60 mm/s, 1500 mm/s², pen delay 20 ms)"), std::string::npos)
+      << r.err;
+}
+
+TEST_F(MachineCli, PlotGcodeWithTheRampsProfileIsWhatTheSameFlagsWrite) {
+  const std::string plot = "plot '" + kTeapot + "' --fit 150x100 --lines 3 --format gcode -q";
+  const RunResult profile = Run(plot + " --machine '" + kMachines + "/ramps.toml'");
+  const RunResult flags =
+      Run(plot +
+          " --flavor marlin --pen servo --servo-up 90 --servo-down 30 --servo-index 0"
+          " --feed 1500 --travel-rate 3000 --dwell 0.2");
+  ASSERT_EQ(profile.exit_code, 0) << profile.err;
+  EXPECT_EQ(profile.out, flags.out);
+  EXPECT_NE(profile.out.find("M280 P0 S30"), std::string::npos);
+}
+
+TEST_F(MachineCli, MachineShowNamesWhereEachSettingCameFrom) {
+  const std::string sim = kMachines + "/sim.toml";
+  const RunResult r = Run("machine show --machine '" + sim + "' --speed 60");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("profile " + sim + " (its lengths in mm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("speed        60                   mm/s       --speed        command line"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("accel        1500                 mm/s²     --accel        profile " + sim +
+                       ":10"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("feed         1500                 mm/min     --feed         default"),
+            std::string::npos)
+      << r.out;
+  // In inches: the profile's millimetres converted (254 mm = 10 in). A step
+  // of 0.0125 mm would be refused: 0.000492... in is no short decimal.
+  const std::string mm = Write("mm.toml", "units = \"mm\"\ntravel = [254, 127]\n");
+  const RunResult in = Run("machine show --machine '" + mm + "' --units in");
+  ASSERT_EQ(in.exit_code, 0) << in.err;
+  EXPECT_NE(in.out.find("travel       10x5                 in"), std::string::npos) << in.out;
+  EXPECT_EQ(Run("machine show --machine '" + sim + "' --units in").exit_code, 2);
+}
+
+TEST_F(MachineCli, ProfileIsFoundByNameUnderXdgConfigHome) {
+  Write("mine.toml", "speed = 42\n");
+  std::filesystem::create_directories(dir_ / "config" / "fdsurf" / "machines");
+  std::filesystem::rename(dir_ / "mine.toml", dir_ / "config/fdsurf/machines/mine.toml");
+  const ScopedEnv xdg("XDG_CONFIG_HOME", (dir_ / "config").c_str());
+  const RunResult r = Run("machine show --machine mine");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("profile " + (dir_ / "config/fdsurf/machines/mine.toml").string() + ":1"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(MachineCli, ProfileUnderHomeConfigIsShownWithATilde) {
+  std::filesystem::create_directories(dir_ / ".config" / "fdsurf" / "machines");
+  std::ofstream(dir_ / ".config/fdsurf/machines/mine.toml") << "\nspeed = 42\n";
+  const ScopedEnv home("HOME", dir_.string().c_str());
+  const ScopedEnv xdg("XDG_CONFIG_HOME", nullptr);
+  const RunResult r = Run("machine show --machine mine");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("42                   mm/s       --speed        profile "
+                       "~/.config/fdsurf/machines/mine.toml:2"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(MachineCli, BadProfileStopsTheCommandBeforeAnythingIsDrawn) {
+  const std::string bad = Write("bad.toml", "speed = 80\nacel = 1500\n");
+  const std::string svg = (dir_ / "never.svg").string();
+  const RunResult r = Run("stream '" + kTeapot + "' --machine '" + bad + "' --svg '" + svg + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "fdsurf: error: " + bad +
+                       ":2:1: key 'acel': not a machine setting (did you mean 'accel'? "
+                       "docs/machines.md lists them)\n");
+  EXPECT_FALSE(std::filesystem::exists(svg));
+  const RunResult missing = Run("plot '" + kTeapot + "' --machine '" + dir_.string() + "/no.toml'");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("no profile file"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace fdsurf::test_support

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: MIT
+#include "machine_command.h"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "../commands.h"
+#include "../stream_command.h"
+#include "fdsurf/host/errors.h"
+#include "profile.h"
+
+namespace fdsurf::host {
+namespace {
+
+// stream and plot with their real options: the defaults shown are theirs,
+// and every value shown went through their checks.
+struct Targets {
+  StreamOptions stream_options;
+  PlotOptions plot_options;
+  CLI::App app;
+  CLI::App* stream = nullptr;
+  CLI::App* plot = nullptr;
+
+  Targets() {
+    stream = app.add_subcommand("stream");
+    AddStreamOptions(stream, &stream_options);
+    plot = app.add_subcommand("plot");
+    AddPlotOptions(plot, &plot_options, false);
+  }
+
+  // Gives `flag` the command line's `text` on both commands that have it.
+  void Give(const std::string& flag, const std::string& text) {
+    for (CLI::App* command : {stream, plot}) {
+      CLI::Option* option = command->get_option_no_throw(flag);
+      if (option == nullptr) continue;
+      try {
+        option->add_result(text);
+        option->run_callback();
+      } catch (const CLI::ParseError& e) {
+        throw InputError(flag + ": " + e.what());
+      }
+    }
+  }
+
+  // The built-in default of `flag`, "(built in)" when it depends on others.
+  FDSURF_NODISCARD std::string DefaultOf(const std::string& flag) const {
+    for (const CLI::App* command : {stream, plot}) {
+      const CLI::Option* option = command->get_option_no_throw(flag);
+      if (option != nullptr && !option->get_default_str().empty()) {
+        return option->get_default_str();
+      }
+    }
+    return "(built in)";
+  }
+};
+
+// `path` with $HOME written as "~", as a user would type it.
+std::string ForShow(const std::string& path) {
+  const char* home = std::getenv("HOME");
+  if (home == nullptr || home[0] == '\0') return path;
+  const std::string prefix = std::string(home) + "/";
+  return path.rfind(prefix, 0) == 0 ? "~/" + path.substr(prefix.size()) : path;
+}
+
+}  // namespace
+
+void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
+  AddMachineOption(command, &options->machine);
+  command->add_option("--units", options->units, "units of the settings shown (default mm)")
+      ->check(CLI::IsMember({"mm", "in"}));
+  const auto& keys = MachineKeys();
+  options->values.resize(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i].option[0] == '\0') continue;
+    command->add_option(keys[i].option, options->values[i], keys[i].help);
+  }
+}
+
+int RunMachineShow(const MachineShowOptions& options) {
+  Targets targets;
+  const std::string units = options.units.empty() ? targets.DefaultOf("--units") : options.units;
+  if (!options.units.empty()) targets.Give("--units", options.units);
+  const auto& keys = MachineKeys();
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (!options.values[i].empty()) targets.Give(keys[i].option, options.values[i]);
+  }
+  MachineProfile profile;
+  if (!options.machine.empty()) {
+    profile = LoadMachineProfile(FindMachineProfile(options.machine));
+    ApplyMachineProfile(profile, targets.stream);
+    ApplyMachineProfile(profile, targets.plot);
+    std::printf("profile %s (its lengths in %s)\n", ForShow(profile.path).c_str(),
+                profile.units.c_str());
+  } else {
+    std::printf("no profile (--machine NAME|FILE)\n");
+  }
+  std::printf("units %s (%s)\n", units.c_str(), options.units.empty() ? "default" : "command line");
+  std::printf("%-12s %-20s %-10s %-14s %s\n", "key", "value", "unit", "option", "source");
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const MachineKey& key = keys[i];
+    if (key.option[0] == '\0') continue;
+    const ProfileValue* in_profile = profile.Find(key.name);
+    std::string value;
+    std::string source;
+    if (!options.values[i].empty()) {
+      value = options.values[i];
+      source = "command line";
+    } else if (in_profile != nullptr) {
+      value = OptionText(profile, *in_profile, units);
+      source = "profile " + ForShow(SourceOf(profile, *in_profile));
+    } else {
+      value = targets.DefaultOf(key.option);
+      source = "default";
+    }
+    const std::string unit = UnitText(key, units);
+    std::printf("%-12s %-20s %-10s %-14s %s\n", key.name, value.c_str(),
+                unit.empty() ? "-" : unit.c_str() + 1, key.option, source.c_str());
+  }
+  return 0;
+}
+
+}  // namespace fdsurf::host

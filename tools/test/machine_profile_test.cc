@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: MIT
+// Machine profiles (machine/profile.h) from hand-written TOML: what a good
+// file gives, each kind of refusal with its file:line:column and key,
+// built-in default < profile < command line, the conversion between the
+// profile's units and the command's, the XDG lookup under a temporary HOME,
+// and that docs/machines.md and the example profiles follow the schema.
+#include "../fdsurf/machine/profile.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fdsurf/host/errors.h"
+
+namespace fdsurf::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The message ParseMachineProfile refuses `toml` with ("" when it takes it).
+std::string RefusalOf(const std::string& toml) {
+  try {
+    (void)ParseMachineProfile(toml, "m.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MachineProfile, GoodFileGivesItsValuesWithTheirLines) {
+  const MachineProfile p = ParseMachineProfile(
+      "# a plotter\n"
+      "units = \"in\"\n"
+      "device = \"sim\"\n"
+      "step = 0.0005\n"
+      "travel = [11.81, 8.58]\n"
+      "speed = 4\n"
+      "pen_delay = 150\n",
+      "m.toml");
+  EXPECT_EQ(p.units, "in");
+  ASSERT_EQ(p.values.size(), 5U);
+  EXPECT_STREQ(p.values[0].key->name, "device");
+  EXPECT_EQ(p.values[0].text, "sim");
+  EXPECT_EQ(p.values[0].line, 3);
+  ASSERT_NE(p.Find("travel"), nullptr);
+  EXPECT_EQ(p.Find("travel")->line, 5);
+  EXPECT_EQ(OptionText(p, *p.Find("travel"), "in"), "11.81x8.58");
+  EXPECT_EQ(OptionText(p, *p.Find("pen_delay"), "mm"), "150");  // ms: not a length
+  EXPECT_EQ(SourceOf(p, *p.Find("speed")), "m.toml:6");
+  EXPECT_EQ(p.Find("accel"), nullptr);
+}
+
+TEST(MachineProfile, LengthsConvertToTheCommandsUnits) {
+  const MachineProfile in = ParseMachineProfile("units = \"in\"\nspeed = 2\ndwell = 0.5\n", "a");
+  EXPECT_EQ(OptionText(in, *in.Find("speed"), "mm"), "50.8");  // 2 × 25.4
+  EXPECT_EQ(OptionText(in, *in.Find("speed"), "in"), "2");
+  EXPECT_EQ(OptionText(in, *in.Find("dwell"), "mm"), "0.5");  // seconds stay seconds
+  const MachineProfile mm = ParseMachineProfile("travel = [254, 127, 25.4]\n", "b");
+  EXPECT_EQ(mm.units, "mm");
+  EXPECT_EQ(OptionText(mm, *mm.Find("travel"), "in"), "10x5x1");
+}
+
+TEST(MachineProfile, SyntaxErrorNamesFileLineAndColumn) {
+  const std::string e = RefusalOf("device = \"sim\"\nspeed = = 3\n");
+  EXPECT_EQ(e.rfind("m.toml:2:", 0), 0U) << e;
+}
+
+TEST(MachineProfile, UnknownKeyIsRefusedWithTheNearestKnownOne) {
+  EXPECT_EQ(RefusalOf("\n  sped = 3\n"),
+            "m.toml:2:3: key 'sped': not a machine setting (did you mean 'speed'? "
+            "docs/machines.md lists them)");
+  EXPECT_NE(RefusalOf("pen_dealy = 3\n").find("did you mean 'pen_delay'"), std::string::npos);
+  EXPECT_NE(RefusalOf("[servo]\nup = 3\n").find("key 'servo'"), std::string::npos);
+  EXPECT_EQ(NearestMachineKey("travle"), "travel");
+  EXPECT_EQ(NearestMachineKey("tick_rate"), "tick_hz");
+}
+
+TEST(MachineProfile, KeysOfFeaturesToComeSaySo) {
+  EXPECT_EQ(RefusalOf("homing = true\n"), "m.toml:1:1: key 'homing': homing is not supported yet");
+  EXPECT_NE(RefusalOf("accel_x = 3\n").find("not supported yet"), std::string::npos);
+  EXPECT_NE(RefusalOf("steps_per_mm = 80\n").find("not supported yet"), std::string::npos);
+}
+
+TEST(MachineProfile, WrongTypeIsRefused) {
+  EXPECT_EQ(RefusalOf("speed = \"fast\"\n"),
+            "m.toml:1:9: key 'speed': must be a number, not string");
+  EXPECT_EQ(RefusalOf("device = 3\n"), "m.toml:1:10: key 'device': must be a string, not integer");
+  EXPECT_NE(RefusalOf("pen_delay = 1.5\n").find("must be an integer, not floating-point"),
+            std::string::npos);
+  EXPECT_NE(RefusalOf("travel = [1, 2, 3, 4]\n").find("must be an array of 2 or 3"),
+            std::string::npos);
+  EXPECT_NE(RefusalOf("travel = [1, \"2\"]\n").find("must be an array of 2 or 3"),
+            std::string::npos);
+}
+
+TEST(MachineProfile, OutOfRangeIsRefused) {
+  EXPECT_EQ(RefusalOf("accel = -5\n"), "m.toml:1:9: key 'accel': must be above 0, not -5");
+  EXPECT_NE(RefusalOf("travel = [300, 0]\n").find("must be above 0, not 0"), std::string::npos);
+  EXPECT_EQ(RefusalOf("units = \"cm\"\n"),
+            "m.toml:1:9: key 'units': must be \"mm\" or \"in\", not \"cm\"");
+  EXPECT_EQ(RefusalOf("speed = 100\nfeed = 1200\n"), "");
+}
+
+// A command with a few of stream's and plot's options, as they declare them.
+struct Command {
+  CLI::App app;
+  std::string units = "mm";
+  double speed = 100;
+  double accel = 2000;
+  int dims = 2;
+  std::string step;
+
+  Command() {
+    app.add_option("--units", units)->check(CLI::IsMember({"mm", "in"}))->capture_default_str();
+    app.add_option("--speed", speed)->capture_default_str();
+    app.add_option("--accel", accel)->capture_default_str();
+    app.add_option("--dims", dims)->check(CLI::IsMember({2, 3}))->capture_default_str();
+    app.add_option("--step", step);
+  }
+  void Parse(std::vector<std::string> args) {
+    std::reverse(args.begin(), args.end());  // CLI11 takes them last first
+    app.parse(args);
+  }
+};
+
+TEST(MachineProfile, CommandLineBeatsProfileBeatsDefault) {
+  Command c;
+  c.Parse({"--speed", "50"});
+  const MachineProfile p = ParseMachineProfile("speed = 200\ndims = 3\n", "m.toml");
+  ApplyMachineProfile(p, &c.app);
+  EXPECT_EQ(c.speed, 50);    // command line
+  EXPECT_EQ(c.dims, 3);      // profile
+  EXPECT_EQ(c.accel, 2000);  // default
+}
+
+TEST(MachineProfile, AppliedInTheCommandsUnits) {
+  Command c;
+  c.Parse({"--units", "in"});
+  ApplyMachineProfile(ParseMachineProfile("speed = 50.8\naccel = 254\n", "m.toml"), &c.app);
+  EXPECT_DOUBLE_EQ(c.speed, 2);
+  EXPECT_DOUBLE_EQ(c.accel, 10);
+}
+
+std::string ApplyRefusal(const std::string& toml, std::vector<std::string> args = {}) {
+  Command c;
+  c.Parse(std::move(args));
+  try {
+    ApplyMachineProfile(ParseMachineProfile(toml, "m.toml"), &c.app);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MachineProfile, TheOptionsOwnChecksApplyWithThePosition) {
+  const std::string dims = ApplyRefusal("\ndims = 4\n");
+  EXPECT_EQ(dims.rfind("m.toml:2:8: key 'dims' (4 for --dims): ", 0), 0U) << dims;
+  // 0.0125 mm is 0.000492125984... in: not a step of at most 9 decimals.
+  const std::string step = ApplyRefusal("step = 0.0125\n", {"--units", "in"});
+  EXPECT_EQ(step.rfind("m.toml:1:8: key 'step' (0.000492125984", 0), 0U) << step;
+  EXPECT_NE(step.find("more than 9"), std::string::npos) << step;
+  // Given on the command line, the profile's value is not even looked at.
+  EXPECT_EQ(ApplyRefusal("dims = 4\n", {"--dims", "2"}), "");
+}
+
+TEST(MachineProfile, LengthsAreRefusedWhileTheCommandsUnitsAreUnknown) {
+  CLI::App app;
+  std::string units;  // no default: the units would come from the drawing
+  double speed = 100;
+  int pen_delay = 100;
+  app.add_option("--units", units);
+  app.add_option("--speed", speed);
+  app.add_option("--pen-delay", pen_delay);
+  app.parse(std::vector<std::string>{});
+  EXPECT_THROW(ApplyMachineProfile(ParseMachineProfile("speed = 3\n", "m.toml"), &app), InputError);
+  ApplyMachineProfile(ParseMachineProfile("pen_delay = 30\n", "m.toml"), &app);
+  EXPECT_EQ(pen_delay, 30);  // not a length: nothing to convert
+}
+
+// HOME and XDG_CONFIG_HOME pointed at a scratch folder for one test.
+class MachineLookup : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("fdsurf_machine_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    for (const char* name : {"HOME", "XDG_CONFIG_HOME"}) {
+      const char* v = std::getenv(name);
+      saved_.emplace_back(name, v == nullptr ? std::optional<std::string>() : v);
+    }
+    ::setenv("HOME", dir_.c_str(), 1);
+    ::unsetenv("XDG_CONFIG_HOME");
+  }
+  void TearDown() override {
+    for (const auto& [name, value] : saved_) {
+      if (value) ::setenv(name.c_str(), value->c_str(), 1);
+      if (!value) ::unsetenv(name.c_str());
+    }
+    fs::remove_all(dir_);
+  }
+  std::string Put(const fs::path& relative) {
+    const fs::path path = dir_ / relative;
+    fs::create_directories(path.parent_path());
+    std::ofstream(path) << "speed = 1\n";
+    return path.string();
+  }
+  fs::path dir_;
+  std::vector<std::pair<std::string, std::optional<std::string>>> saved_;
+};
+
+TEST_F(MachineLookup, NameIsFoundUnderXdgConfigHomeElseHomeConfig) {
+  const std::string home = Put(".config/fdsurf/machines/axi.toml");
+  EXPECT_EQ(FindMachineProfile("axi"), home);
+  const std::string xdg = Put("xdg/fdsurf/machines/axi.toml");
+  ::setenv("XDG_CONFIG_HOME", (dir_ / "xdg").c_str(), 1);
+  EXPECT_EQ(FindMachineProfile("axi"), xdg);
+  // The spec: a relative XDG_CONFIG_HOME is ignored.
+  ::setenv("XDG_CONFIG_HOME", "xdg", 1);
+  EXPECT_EQ(FindMachineProfile("axi"), home);
+  ::setenv("XDG_CONFIG_HOME", "", 1);
+  EXPECT_EQ(FindMachineProfile("axi"), home);
+}
+
+TEST_F(MachineLookup, FileIsTakenAsGivenAndMissingOnesAreNamed) {
+  const std::string file = Put("elsewhere/my.toml");
+  EXPECT_EQ(FindMachineProfile(file), file);
+  try {
+    (void)FindMachineProfile("ramps");
+    FAIL() << "no profile ramps, yet found";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "--machine ramps: no profile " + dir_.string() +
+                                         "/.config/fdsurf/machines/ramps.toml");
+  }
+  EXPECT_THROW((void)FindMachineProfile("nothere.toml"), InputError);
+  EXPECT_EQ(LoadMachineProfile(file).Find("speed")->numbers[0], 1);
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(MachineProfile, DocsListEveryKeyOfTheSchema) {
+  const std::string docs = ReadText(fs::path(FDSURF_SOURCE_DIR) / "docs" / "machines.md");
+  ASSERT_FALSE(docs.empty());
+  for (const MachineKey& key : MachineKeys()) {
+    EXPECT_NE(docs.find(std::string("| `") + key.name + "` |"), std::string::npos) << key.name;
+  }
+}
+
+TEST(MachineProfile, ExampleProfilesParse) {
+  int seen = 0;
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(FDSURF_SOURCE_DIR) / "examples" / "machines")) {
+    if (entry.path().extension() != ".toml") continue;
+    EXPECT_NO_THROW((void)LoadMachineProfile(entry.path().string())) << entry.path();
+    ++seen;
+  }
+  EXPECT_EQ(seen, 3);
+}
+
+}  // namespace
+}  // namespace fdsurf::host
