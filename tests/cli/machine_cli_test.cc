@@ -109,8 +109,8 @@ TEST_F(MachineCli, MachineShowNamesWhereEachSettingCameFrom) {
   EXPECT_NE(r.out.find("speed        60                   mm/s       --speed        command line"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("accel        1500                 mm/s²     --accel        profile " + sim +
-                       ":10"),
+  EXPECT_NE(r.out.find("accel        1500                 mm/s²      --accel        profile " +
+                       sim + ":10"),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("feed         1500                 mm/min     --feed         default"),
@@ -123,6 +123,17 @@ TEST_F(MachineCli, MachineShowNamesWhereEachSettingCameFrom) {
   ASSERT_EQ(in.exit_code, 0) << in.err;
   EXPECT_NE(in.out.find("travel       10x5                 in"), std::string::npos) << in.out;
   EXPECT_EQ(Run("machine show --machine '" + sim + "' --units in").exit_code, 2);
+  // The built-in defaults as the commands convert them (1500 mm/min, 100 mm/s).
+  const RunResult defaults = Run("machine show --units in");
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  EXPECT_NE(
+      defaults.out.find("feed         59.0551              in/min     --feed         default"),
+      std::string::npos)
+      << defaults.out;
+  EXPECT_NE(
+      defaults.out.find("speed        3.93701              in/s       --speed        default"),
+      std::string::npos)
+      << defaults.out;
 }
 
 TEST_F(MachineCli, ProfileIsFoundByNameUnderXdgConfigHome) {

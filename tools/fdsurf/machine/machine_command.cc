@@ -5,10 +5,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
+#include "../cli_options.h"
 #include "../commands.h"
 #include "../stream_command.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/stream.h"
+#include "fdsurf/host/text.h"
+#include "fdsurf/host/writers.h"
 #include "profile.h"
 
 namespace fdsurf::host {
@@ -44,17 +49,52 @@ struct Targets {
     }
   }
 
-  // The built-in default of `flag`, "(built in)" when it depends on others.
-  FDSURF_NODISCARD std::string DefaultOf(const std::string& flag) const {
+  // The built-in default of `flag` in `units`: CLI11's default text, or for
+  // the options whose default is converted for --units (left empty in CLI11)
+  // the library's mm default converted as the commands convert it.
+  FDSURF_NODISCARD std::string DefaultOf(const std::string& flag, const std::string& units) const {
     for (const CLI::App* command : {stream, plot}) {
       const CLI::Option* option = command->get_option_no_throw(flag);
       if (option != nullptr && !option->get_default_str().empty()) {
         return option->get_default_str();
       }
     }
+    return UnitDefaultOf(flag, units);
+  }
+
+ private:
+  static std::string UnitDefaultOf(const std::string& flag, const std::string& units) {
+    const MachineOptions machine;
+    const GcodeOptions gcode;
+    const std::pair<const char*, double> lengths[] = {{"--speed", machine.speed},
+                                                      {"--accel", machine.accel},
+                                                      {"--pen-up", gcode.pen_up_z},
+                                                      {"--pen-down", gcode.pen_down_z},
+                                                      {"--feed", gcode.feed},
+                                                      {"--plunge-feed", gcode.plunge_feed},
+                                                      {"--travel-rate", gcode.travel_rate}};
+    for (const auto& [name, mm] : lengths) {
+      if (flag == name) return FormatNumber(DefaultIn(mm, units));
+    }
+    if (flag == "--step") {
+      const Quantum step = DefaultStepIn(machine.step, units);
+      return step.Format(1);
+    }
+    if (flag == "--travel") return "the page";
+    if (flag == "--tick-hz") return "the device's";
     return "(built in)";
   }
 };
+
+// `text` padded with spaces to `width` characters: printf's %-10s counts
+// bytes, and "mm/s²" is 6 bytes but 5 characters.
+std::string PadTo(const std::string& text, std::size_t width) {
+  std::size_t characters = 0;
+  for (const char c : text) {
+    if ((static_cast<unsigned char>(c) & 0xC0) != 0x80) ++characters;  // not a continuation byte
+  }
+  return text + std::string(characters < width ? width - characters : 0, ' ');
+}
 
 // `path` with $HOME written as "~", as a user would type it.
 std::string ForShow(const std::string& path) {
@@ -80,7 +120,8 @@ void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
 
 int RunMachineShow(const MachineShowOptions& options) {
   Targets targets;
-  const std::string units = options.units.empty() ? targets.DefaultOf("--units") : options.units;
+  const std::string units =
+      options.units.empty() ? targets.DefaultOf("--units", "") : options.units;
   if (!options.units.empty()) targets.Give("--units", options.units);
   const auto& keys = MachineKeys();
   for (std::size_t i = 0; i < keys.size(); ++i) {
@@ -111,12 +152,12 @@ int RunMachineShow(const MachineShowOptions& options) {
       value = OptionText(profile, *in_profile, units);
       source = "profile " + ForShow(SourceOf(profile, *in_profile));
     } else {
-      value = targets.DefaultOf(key.option);
+      value = targets.DefaultOf(key.option, units);
       source = "default";
     }
     const std::string unit = UnitText(key, units);
-    std::printf("%-12s %-20s %-10s %-14s %s\n", key.name, value.c_str(),
-                unit.empty() ? "-" : unit.c_str() + 1, key.option, source.c_str());
+    std::printf("%-12s %-20s %s %-14s %s\n", key.name, value.c_str(),
+                PadTo(unit.empty() ? "-" : unit.substr(1), 10).c_str(), key.option, source.c_str());
   }
   return 0;
 }

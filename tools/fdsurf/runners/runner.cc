@@ -12,6 +12,7 @@
 #include "../cli_options.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/text.h"
 #include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/codec.h"
 
@@ -131,9 +132,9 @@ std::string DecodeDeviceError(const std::string& message) {
 // A device moves at most one step per axis per tick.
 void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const StreamOptions& o) {
   if (job.config.max_rate > tick_hz) {
-    throw InputError("--speed " + std::to_string(static_cast<int>(o.speed)) + " " + o.units +
-                     "/s is " + std::to_string(job.config.max_rate) +
-                     " steps/s, more than the device's " + std::to_string(tick_hz) +
+    throw InputError("--speed " + FormatNumber(o.speed) + " " + o.units + "/s is " +
+                     std::to_string(job.config.max_rate) + " steps/s, more than the device's " +
+                     std::to_string(tick_hz) +
                      " ticks/s (one step per tick at most): lower --speed or raise --tick-hz");
   }
 }

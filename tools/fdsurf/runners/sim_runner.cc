@@ -9,6 +9,7 @@
 
 #include "../cli_options.h"
 #include "fdsurf/host/plan.h"
+#include "fdsurf/host/text.h"
 #include "fdsurf/host/writers.h"
 #include "fdsurf/protocol/codec.h"
 #include "fdsurf/sim/checks.h"
@@ -222,8 +223,9 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
       checked.limits_kept
           ? std::string("kept")
           : std::to_string(motion.violations) + " violations, first: " + motion.first_violation;
-  std::fprintf(stderr, "motion limits (%.0f %s/s, %.0f %s/s², pen delay %d ms): %s\n", o.speed,
-               units.c_str(), o.accel, units.c_str(), o.pen_delay_ms, limits.c_str());
+  std::fprintf(stderr, "motion limits (%s %s/s, %s %s/s², pen delay %d ms): %s\n",
+               FormatNumber(o.speed).c_str(), units.c_str(), FormatNumber(o.accel).c_str(),
+               units.c_str(), o.pen_delay_ms, limits.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
   if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
   if (!o.png.empty()) {
