@@ -5,6 +5,7 @@
 // analytic motion over the same windows, never the checker.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -100,6 +101,43 @@ TEST(CheckMotionAxisAccel, MeasuresAConstantAccelerationRampOnX) {
   const MotionReport tight = CheckMotion(steps, {}, GenerousLimits(0.8 * a), kWindow);
   EXPECT_GT(tight.violations, 0u);
   EXPECT_EQ(tight.first_violation.rfind("axis X: ", 0), 0u) << tight.first_violation;
+}
+
+TEST(CheckMotionAxisAccel, TheAllowanceCoversCountingInWholeSteps) {
+  // A gentle trapezoid (1000 steps/s² to 1010.5 steps/s): windows of the
+  // cruise hold 20 or 21 steps, so the counted velocity jumps by 1/W =
+  // 50 steps/s where the motion's does not change, more than a·W = 20.
+  constexpr double a = 1000;
+  constexpr double ramp = 1.0105;
+  constexpr double cruise = 0.5;
+  const Motion motion = [&](double t) -> std::array<double, 3> {
+    const double up = std::min(t, ramp);
+    const double level = std::clamp(t - ramp, 0.0, cruise);
+    const double down = std::clamp(t - ramp - cruise, 0.0, ramp);
+    return {0.5 * a * up * up + a * ramp * (level + down) - 0.5 * a * down * down, 0, 0};
+  };
+  const std::vector<hal::StepDirEvent> steps = StepsOf(motion, 2 * ramp + cruise + 0.05);
+  const MotionReport report = CheckMotion(steps, {}, GenerousLimits(a), kWindow);
+  EXPECT_GT(report.max_axis_accel[0], 2 * a);  // the counting, not the motion
+  EXPECT_LE(report.max_axis_accel[0], a + kQuantisation);
+  EXPECT_EQ(report.violations, 0u) << report.first_violation;
+}
+
+TEST(CheckMotionAxisAccel, CountsAReversalAtSpeedWithItsDirection) {
+  // X at 5000 steps/s turns back at once at 0.1 s (a window boundary): its
+  // velocity changes by 2·5000 steps/s between two windows. Counted without
+  // the direction, the speed would not change at all there.
+  constexpr double v = 5000;
+  constexpr double turn = 0.1;
+  const Motion motion = [](double t) -> std::array<double, 3> {
+    return {t <= turn ? v * t : std::max(0.0, v * (2 * turn - t)), 0, 0};
+  };
+  const std::vector<hal::StepDirEvent> steps = StepsOf(motion, 2 * turn + 0.05);
+  const double last_step_s = static_cast<double>(steps.back().time_us) * 1e-6;
+  const MotionReport report = CheckMotion(steps, {}, GenerousLimits(0), kWindow);
+  const double exact = ExactWindowedAccel(motion, 0, last_step_s);
+  EXPECT_NEAR(exact, 2 * v / kWindow, 1e-6 * v / kWindow);
+  EXPECT_NEAR(report.max_axis_accel[0], exact, kQuantisation);
 }
 
 TEST(CheckMotionAxisAccel, MeasuresTheCentripetalAccelerationOfACircle) {
