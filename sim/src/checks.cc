@@ -317,7 +317,7 @@ void CheckWindowAxisAccel(double window_s, MotionCheck& c) {
   for (int axis = 0; axis < 3; ++axis) {
     double& largest = c.report.max_axis_accel[axis];
     ForEachWindowChange(
-        c.time, window_s, [&](std::size_t k) { return double{c.position[k][axis]}; },
+        c.time, window_s, [&](std::size_t k) { return static_cast<double>(c.position[k][axis]); },
         [&](double t, double signed_change) {
           const double change = std::fabs(signed_change);
           largest = std::max(largest, change / window_s);
