@@ -138,14 +138,16 @@ DrawingComparison CompareDrawing(const std::vector<DrawnPath>& drawn,
 
 namespace {
 
-std::string Describe(const char* format, double x, double y, double z) {
+std::string Describe(const char* format, double x, double y, double z, double w = 0) {
   char text[200];
-  std::snprintf(text, sizeof text, format, x, y, z);
+  std::snprintf(text, sizeof text, format, x, y, z, w);
   return std::string(text);
 }
 
 // The working state of CheckMotion: the report it fills, and the moves'
-// completion times with the cumulative path length (steps) after each.
+// completion times with the cumulative path length (steps) and each axis's
+// position (signed steps from the start; 32 bits hold any plannable travel,
+// 2²⁶) after each.
 struct MotionCheck {
   const MotionLimitsSi& limits;
   double tick_s;
@@ -153,6 +155,7 @@ struct MotionCheck {
   MotionReport report;
   std::vector<double> time;
   std::vector<double> distance;
+  std::vector<std::array<std::int32_t, 3>> position;
 
   void Violation(const std::string& what) {
     if (report.violations++ == 0) report.first_violation = what;
@@ -164,6 +167,7 @@ void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
   MotionReport& report = c.report;
   double total = 0;
   std::array<double, 3> last_step{-1, -1, -1};
+  std::array<std::int32_t, 3> position{};
   report.min_axis_interval_us = HUGE_VAL;
   const double min_interval_s =
       std::floor(static_cast<double>(c.limits.tick_hz) / c.limits.max_rate) * c.tick_s;
@@ -184,10 +188,12 @@ void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
         }
       }
       last_step[axis] = t;
+      position[axis] += (e.negative_mask >> axis & 1) != 0 ? -1 : 1;
     }
     total += std::sqrt(static_cast<double>(axes));
     c.time.push_back(t);
     c.distance.push_back(total);
+    c.position.push_back(position);
   }
   report.moves = c.time.size();
   report.path_length = total;
@@ -265,26 +271,63 @@ void CheckWindowSpeed(double window_s, MotionCheck& c) {
   }
 }
 
+// Windows of window_s tiled from t = 0 over the run, for a quantity known
+// after each move (value(k) just after move k, 0 before the first): calls
+// on_change(t, change) with the change of its average rate from the window
+// before t to the window [t, t + W). The first window is compared with rest.
+template <typename Value, typename OnChange>
+void ForEachWindowChange(const std::vector<double>& time, double window_s, const Value& value,
+                         const OnChange& on_change) {
+  const auto value_at = [&](double t) {
+    const auto it = std::upper_bound(time.begin(), time.end(), t);
+    return it == time.begin() ? 0.0 : value(static_cast<std::size_t>(it - time.begin()) - 1);
+  };
+  double previous = 0;
+  for (double t = 0; t < time.back(); t += window_s) {
+    const double rate = (value_at(t + window_s) - value_at(t)) / window_s;
+    on_change(t, rate - previous);
+    previous = rate;
+  }
+}
+
 // Windowed acceleration: average speeds of neighbouring windows differ by
 // at most a·W; each estimate errs by under 2·√3/W (a move in progress at
 // each end), so the test allows a·W + 4·√3/W.
 void CheckWindowAccel(double window_s, MotionCheck& c) {
-  const std::vector<double>& time = c.time;
-  const auto distance_at = [&](double t) {
-    const auto it = std::upper_bound(time.begin(), time.end(), t);
-    return it == time.begin() ? 0.0 : c.distance[static_cast<std::size_t>(it - time.begin()) - 1];
-  };
   const double allowance = c.a * window_s + 4 * std::sqrt(3.0) / window_s;
-  double previous = 0;
-  for (double t = 0; t < time.back(); t += window_s) {
-    const double speed = (distance_at(t + window_s) - distance_at(t)) / window_s;
-    const double change = std::fabs(speed - previous);
-    c.report.max_accel = std::max(c.report.max_accel, change / window_s);
-    if (change > allowance + 1e-9) {
-      c.Violation(Describe("the speed changed by %.1f steps/s within %.3f s (allowed %.1f)", change,
-                           window_s, allowance));
-    }
-    previous = speed;
+  ForEachWindowChange(
+      c.time, window_s, [&](std::size_t k) { return c.distance[k]; },
+      [&](double /*t*/, double signed_change) {
+        const double change = std::fabs(signed_change);
+        c.report.max_accel = std::max(c.report.max_accel, change / window_s);
+        if (change > allowance + 1e-9) {
+          c.Violation(Describe("the speed changed by %.1f steps/s within %.3f s (allowed %.1f)",
+                               change, window_s, allowance));
+        }
+      });
+}
+
+// The same per axis, on its signed position: the average velocities of
+// neighbouring windows differ by at most axis_accel·W; the position counted
+// from steps is within one step of the axis's continuous position (a step in
+// progress, either way), so each change errs by under 4/W and the test
+// allows axis_accel·W + 4/W (docs/motion.md).
+void CheckWindowAxisAccel(double window_s, MotionCheck& c) {
+  const double allowance = c.limits.axis_accel * window_s + 4 / window_s;
+  for (int axis = 0; axis < 3; ++axis) {
+    double& largest = c.report.max_axis_accel[axis];
+    ForEachWindowChange(
+        c.time, window_s, [&](std::size_t k) { return static_cast<double>(c.position[k][axis]); },
+        [&](double t, double signed_change) {
+          const double change = std::fabs(signed_change);
+          largest = std::max(largest, change / window_s);
+          if (c.limits.axis_accel > 0 && change > allowance + 1e-9) {
+            c.Violation(std::string("axis ") + "XYZ"[axis] +
+                        Describe(": its velocity changed by %.1f steps/s in the %.3f s window at "
+                                 "%.6f s (axis accel limit allows %.1f)",
+                                 change, window_s, t, allowance));
+          }
+        });
   }
 }
 
@@ -293,13 +336,14 @@ void CheckWindowAccel(double window_s, MotionCheck& c) {
 MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
                          const std::vector<hal::PenEvent>& pens, const MotionLimitsSi& limits,
                          double window_s) {
-  MotionCheck check{limits, 1.0 / limits.tick_hz, limits.accel, {}, {}, {}};
+  MotionCheck check{limits, 1.0 / limits.tick_hz, limits.accel, {}, {}, {}, {}};
   TraceMoves(steps, check);
   if (check.time.empty()) return check.report;
   CheckPenDelays(pens, check);
   CheckRests(pens, check);
   CheckWindowSpeed(window_s, check);
   CheckWindowAccel(window_s, check);
+  CheckWindowAxisAccel(window_s, check);
   return check.report;
 }
 

@@ -2,6 +2,7 @@
 // The simulated plotter as the device: the job runs in virtual time, then
 // the drawing is compared with the exact curves and the recorded steps with
 // the machine's limits.
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -209,11 +210,16 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                "the same tolerance (%.1fx smaller)\n",
                command_bytes, gcode_bytes,
                static_cast<double>(gcode_bytes) / static_cast<double>(command_bytes));
+  const auto& axis_accel = motion.max_axis_accel;
+  const int fastest_axis =
+      static_cast<int>(std::max_element(axis_accel.begin(), axis_accel.end()) - axis_accel.begin());
   std::fprintf(stderr,
                "machine: %.1f s, %zu moves, %.0f %s of path (%zu pen-down strokes, %zu points), "
-               "top speed %.1f %s/s\n",
+               "top speed %.1f %s/s, top axis acceleration %s %s/s² (%c)\n",
                motion.duration_s, motion.moves, motion.path_length * step, units.c_str(),
-               checked.drawn.size(), points, motion.max_speed * step, units.c_str());
+               checked.drawn.size(), points, motion.max_speed * step, units.c_str(),
+               FormatNumber(axis_accel[fastest_axis] * step, 4).c_str(), units.c_str(),
+               "XYZ"[fastest_axis]);
   std::fprintf(stderr,
                "drawing vs exact curves: max deviation %.3f steps (%.4f %s), max gap %.3f steps; "
                "bound %.3f steps (--tolerance): %s\n",
@@ -223,9 +229,14 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
       checked.limits_kept
           ? std::string("kept")
           : std::to_string(motion.violations) + " violations, first: " + motion.first_violation;
-  std::fprintf(stderr, "motion limits (%s %s/s, %s %s/s², pen delay %d ms): %s\n",
+  // The profile limits the path's acceleration, not each axis's (the
+  // centripetal part on curves): the axes' is reported, not checked.
+  std::fprintf(stderr,
+               "motion limits (%s %s/s, %s %s/s², pen delay %d ms): %s; axis acceleration %s "
+               "%s/s² (not limited)\n",
                FormatNumber(o.speed).c_str(), units.c_str(), FormatNumber(o.accel).c_str(),
-               units.c_str(), o.pen_delay_ms, limits.c_str());
+               units.c_str(), o.pen_delay_ms, limits.c_str(),
+               FormatNumber(axis_accel[fastest_axis] * step, 4).c_str(), units.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
   if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
   if (!o.png.empty()) {

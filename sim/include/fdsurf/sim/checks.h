@@ -44,6 +44,9 @@ struct MotionLimitsSi {
   std::uint32_t tick_hz = 40000;
   double max_rate = 0;  ///< path speed, steps/s
   double accel = 0;     ///< path acceleration, steps/s²
+  /// Acceleration of each axis on its own (the centripetal part on curves
+  /// included), steps/s²; 0: measured but not checked.
+  double axis_accel = 0;
   double pen_delay_s = 0;
 };
 
@@ -55,10 +58,14 @@ struct MotionReport {
   /// Largest change of the windowed speed between neighbouring windows,
   /// divided by the window: steps/s².
   double max_accel = 0;
+  /// Per axis (x, y, z), the largest change of the axis's windowed velocity
+  /// (signed steps, so a reversal counts) between neighbouring windows,
+  /// divided by the window: steps/s².
+  std::array<double, 3> max_axis_accel{};
   /// Violations of: the per-axis step interval, the speed limit, the
   /// start-from-rest and stop-at-rest acceleration laws, the pen delay, the
-  /// windowed acceleration (each with the quantisation allowance in
-  /// docs/motion.md).
+  /// windowed acceleration of the path and (when `axis_accel` is set) of
+  /// each axis (each with the quantisation allowance in docs/motion.md).
   std::size_t violations = 0;
   std::string first_violation;
   std::size_t moves = 0;
