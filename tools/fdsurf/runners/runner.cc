@@ -156,6 +156,8 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
   if (machine_seconds > 0) {
     std::snprintf(rate, sizeof rate, "%.1f s machine time, %.0fx real time", machine_seconds,
                   wall > 0 ? machine_seconds / wall : 0.0);
+  } else if (schedule_ != nullptr) {
+    std::snprintf(rate, sizeof rate, "%s", DescribeTimeLeft(*schedule_, executed).c_str());
   } else {
     std::snprintf(rate, sizeof rate, "%.2f commands/s",
                   wall > 0 ? static_cast<double>(executed) / wall : 0.0);
