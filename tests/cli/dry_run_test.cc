@@ -53,7 +53,10 @@ TEST_F(DryRunTest, TeapotMachineTimeIsTheSimulatedRunsFigure) {
   // The teapot fitted to 200x150 mm lies on that page.
   const std::string extent = Find(dry.out, "page extent drawn: (.*) mm");
   EXPECT_NE(extent.find("x "), std::string::npos);
-  EXPECT_NE(dry.out.find("commands: "), std::string::npos);
+  EXPECT_NE(dry.out.find("commands: 33;"), std::string::npos) << dry.out;
+  // Each pen-down stroke ends in a lift: the simulated run's stroke count.
+  EXPECT_EQ(Find(dry.out, "([0-9]+) pen lifts"),
+            Find(real.err, "mm of path \\(([0-9]+) pen-down strokes"));
 }
 
 // A 100 x 50 mm rectangle drawn along the axes: the step path is exact there
@@ -68,13 +71,13 @@ TEST_F(DryRunTest, RectanglePenDownIsItsPerimeter) {
   const RunResult dry = Run("stream '" + svg + "' --origin keep --dry-run");
   ASSERT_EQ(dry.exit_code, 0) << dry.err;
   EXPECT_EQ(Find(dry.out, "pen down: ([0-9.]+) mm"), "300.0");
-  EXPECT_EQ(Find(dry.out, "([0-9]+) pen lifts"), "1");
+  EXPECT_EQ(Find(dry.out, "([0-9]+) pen lift"), "1");
   EXPECT_EQ(Find(dry.out, "page extent drawn: x ([0-9.]+\\.\\.[0-9.]+),"), "10..110");
 }
 
 TEST_F(DryRunTest, RealDeviceIsNotOpened) {
-  const RunResult dry = Run("stream '" + kTeapot + "' --device serial:/dev/does-not-exist --dry-run" +
-                            kTeapotOptions);
+  const RunResult dry = Run("stream '" + kTeapot +
+                            "' --device serial:/dev/does-not-exist --dry-run" + kTeapotOptions);
   ASSERT_EQ(dry.exit_code, 0) << dry.err;
   EXPECT_NE(dry.out.find("nothing sent to serial:/dev/does-not-exist"), std::string::npos)
       << dry.out;
@@ -114,6 +117,17 @@ TEST(TimeLeft, FromTheScheduleAndTheExecutedCount) {
   EXPECT_EQ(beyond.elapsed_s, 379);
   EXPECT_EQ(beyond.left_s, 0);
   EXPECT_EQ(host::DescribeTimeLeft(host::MachineSchedule{}, 3), "elapsed 0:00, about 0:00 left");
+}
+
+// Time spent on the command running counts, up to its scheduled length.
+TEST(TimeLeft, IntoTheCommandRunning) {
+  const host::MachineSchedule schedule = FiveCommands();
+  EXPECT_EQ(host::TimeLeftAt(schedule, 3, 30).elapsed_s, 40);  // 10 s + 30 s into the 4th
+  EXPECT_EQ(host::TimeLeftAt(schedule, 3, 30).left_s, 339);
+  EXPECT_EQ(host::TimeLeftAt(schedule, 3, 500).elapsed_s, 83);  // no further than its end
+  EXPECT_EQ(host::TimeLeftAt(schedule, 0, 0.5).elapsed_s, 0.5);
+  EXPECT_EQ(host::TimeLeftAt(schedule, 5, 9).elapsed_s, 379);  // nothing after the last
+  EXPECT_EQ(host::DescribeTimeLeft(schedule, 4, 60), "elapsed 2:23, about 3:56 left");
 }
 
 TEST(TimeLeft, ClockReadings) {

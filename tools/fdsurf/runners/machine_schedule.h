@@ -33,15 +33,21 @@ struct TimeLeft {
 };
 
 /// The machine time by which `executed` commands were done in the schedule,
-/// and what the schedule has after it. A count beyond the schedule (a job
-/// refitted to the device, FitJobToDevice) counts as the end.
-inline TimeLeft TimeLeftAt(const MachineSchedule& schedule, std::uint64_t executed) {
+/// plus `running_s` into the next command (at most its scheduled length:
+/// the time the device has spent on it so far, for a smooth reading when a
+/// command runs for seconds), and what the schedule has after that. A count
+/// beyond the schedule (a job refitted to the device, FitJobToDevice) counts
+/// as the end.
+inline TimeLeft TimeLeftAt(const MachineSchedule& schedule, std::uint64_t executed,
+                           double running_s = 0) {
+  const auto done_by = [&schedule](std::uint64_t count) {
+    if (count == 0 || schedule.executed_s.empty()) return 0.0;
+    const std::uint64_t last = std::min<std::uint64_t>(count, schedule.executed_s.size());
+    return schedule.executed_s[static_cast<std::size_t>(last) - 1];
+  };
   TimeLeft t;
-  if (executed > 0 && !schedule.executed_s.empty()) {
-    const std::size_t index =
-        static_cast<std::size_t>(std::min<std::uint64_t>(executed, schedule.executed_s.size())) - 1;
-    t.elapsed_s = schedule.executed_s[index];
-  }
+  const double next = done_by(executed + 1);
+  t.elapsed_s = std::min(next, done_by(executed) + std::max(0.0, running_s));
   t.left_s = std::max(0.0, schedule.total_s() - t.elapsed_s);
   return t;
 }
@@ -61,8 +67,9 @@ inline std::string FormatClock(double seconds) {
 }
 
 /// "elapsed 1:23, about 4:56 left" (machine time) for the progress line.
-inline std::string DescribeTimeLeft(const MachineSchedule& schedule, std::uint64_t executed) {
-  const TimeLeft t = TimeLeftAt(schedule, executed);
+inline std::string DescribeTimeLeft(const MachineSchedule& schedule, std::uint64_t executed,
+                                    double running_s = 0) {
+  const TimeLeft t = TimeLeftAt(schedule, executed, running_s);
   return "elapsed " + FormatClock(t.elapsed_s) + ", about " + FormatClock(t.left_s) + " left";
 }
 

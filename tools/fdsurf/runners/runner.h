@@ -122,6 +122,8 @@ class ProgressLine {
   bool shown_ = false;
   std::string layer_;
   const MachineSchedule* schedule_ = nullptr;
+  std::uint64_t last_executed_ = 0;
+  Clock::time_point executed_changed_;
   Clock::time_point start_;
   Clock::time_point last_;
 };

@@ -303,9 +303,9 @@ DryRunFigures MeasureDryRun(const sim::SimulatedPlotter& plotter,
       f.drew = true;
       if (k == 0) continue;
       const auto& q = path.points[k - 1];
-      f.pen_down_steps += std::hypot(static_cast<double>(p[0] - q[0]),
-                                     static_cast<double>(p[1] - q[1]),
-                                     static_cast<double>(p[2] - q[2]));
+      f.pen_down_steps +=
+          std::hypot(static_cast<double>(p[0] - q[0]), static_cast<double>(p[1] - q[1]),
+                     static_cast<double>(p[2] - q[2]));
     }
   }
   f.pen_up_steps = std::max(0.0, total - f.pen_down_steps);
@@ -325,13 +325,15 @@ void PrintDryRun(const StreamOptions& o, const StreamJob& job, std::uint32_t tic
                  const DryRunFigures& f) {
   const double step = job.page.quantum.value();
   const char* units = o.units.c_str();
-  std::printf("%s: dry run of %s on the simulated plotter (%d axes, %u Hz ticks, %s); nothing "
-              "sent to %s\n",
-              o.file.c_str(), JobContents(job).c_str(), o.dims, tick_hz, TickSource(o).c_str(),
-              o.device.c_str());
+  std::printf(
+      "%s: dry run of %s on the simulated plotter (%d axes, %u Hz ticks, %s); nothing "
+      "sent to %s\n",
+      o.file.c_str(), JobContents(job).c_str(), o.dims, tick_hz, TickSource(o).c_str(),
+      o.device.c_str());
   std::printf("machine time: %.1f s (%s)\n", f.machine_s, FormatClock(f.machine_s).c_str());
-  std::printf("pen down: %.1f %s, pen up (travel): %.1f %s, %zu pen lifts\n",
-              f.pen_down_steps * step, units, f.pen_up_steps * step, units, f.pen_lifts);
+  std::printf("pen down: %.1f %s, pen up (travel): %.1f %s, %zu pen lift%s\n",
+              f.pen_down_steps * step, units, f.pen_up_steps * step, units, f.pen_lifts,
+              f.pen_lifts == 1 ? "" : "s");
   if (f.drew) {
     std::string extent = "page extent drawn: x " + FormatNumber(f.lo[0] * step) + ".." +
                          FormatNumber(f.hi[0] * step) + ", y " + FormatNumber(f.lo[1] * step) +
