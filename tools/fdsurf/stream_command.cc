@@ -242,8 +242,8 @@ int RunStream(const StreamOptions& options) {
   const bool drawing_out = !o.svg.empty() || !o.png.empty() || !o.waveform.empty();
   if (!sim && ((drawing_out && !o.dry_run) || o.faults > 0 || o.sim_cost != "none")) {
     throw InputError(
-        "--svg, --png and --waveform are for --device sim or --dry-run; --faults and --sim-cost "
-        "for --device sim");
+        "--svg, --png, --waveform, --faults and --sim-cost are for --device sim (--svg, --png "
+        "and --waveform also for --dry-run)");
   }
   if ((sim || o.dry_run) && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000" +
