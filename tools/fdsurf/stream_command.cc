@@ -3,13 +3,16 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <utility>
 
 #include "cli_options.h"
 #include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/host/text.h"
+#include "runners/machine_schedule.h"
 #include "runners/runner.h"
 #include "runners/serial_session.h"
 
@@ -87,20 +90,39 @@ DeviceKind DeviceKindOf(const std::string& device) {
   return DeviceKind::kUnknown;
 }
 
-// Builds the job of `set` and streams it to the device o.device names.
+// A real device's progress line shows machine time elapsed and left from
+// the job's schedule: a quiet run on the simulated plotter first (the
+// teapot's takes about a second, docs/protocol.md), only when the progress
+// line shows. The device's own tick rate is known only after HELLO: the
+// schedule assumes DryRunTickHz.
+StreamOptions WithSchedule(const StreamOptions& o, const StreamJob& job) {
+  StreamOptions real = o;
+  const std::uint32_t tick_hz = DryRunTickHz(o);
+  if (!ShowProgress(o.quiet) || 1'000'000 % tick_hz != 0) return real;
+  MachineSchedule schedule = ScheduleJob(o, job, tick_hz);
+  if (!schedule.executed_s.empty()) {
+    real.schedule = std::make_shared<const MachineSchedule>(std::move(schedule));
+  }
+  return real;
+}
+
+// Builds the job of `set` and streams it to the device o.device names (or,
+// with --dry-run, to the simulated plotter only).
 int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptions& drawing,
                 const MachineOptions& machine) {
   const StreamJob job = BuildStreamJob(set, drawing, machine, o.units);
   try {
-    switch (DeviceKindOf(o.device)) {
-      case DeviceKind::kSim:
-        return RunSimulated(o, set, job, drawing, o.units);
+    if (o.dry_run) return RunDryRun(o, job);
+    const DeviceKind kind = DeviceKindOf(o.device);
+    if (kind == DeviceKind::kSim) return RunSimulated(o, set, job, drawing, o.units);
+    const StreamOptions real = WithSchedule(o, job);
+    switch (kind) {
       case DeviceKind::kUsb:
-        return RunUsb(o, job);
+        return RunUsb(real, job);
       case DeviceKind::kSerial:
-        return RunSerial(o, job);
+        return RunSerial(real, job);
       default:
-        return RunGpio(o, job);
+        return RunGpio(real, job);
     }
   } catch (const DeviceError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
@@ -199,6 +221,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                    "show (every line) or remove (only the visible pieces, streamed as curves)")
       ->check(CLI::IsMember({"show", "remove"}));
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
+  command->add_flag("--dry-run", o->dry_run,
+                    "run the job through the simulated plotter with these limits and report "
+                    "machine time, pen-down and pen-up distance, pen lifts and the page extent; "
+                    "nothing is sent to --device");
   command->add_flag("--no-pause", o->no_pause,
                     "between layers, say that the pen is to be changed but do not wait for Enter");
 }
@@ -213,12 +239,15 @@ int RunStream(const StreamOptions& options) {
                      "' is not sim, usb[:VID:PID|:BUS-PORT], serial:PATH[:BAUD], serial:auto or "
                      "gpio:CHIP:LINES");
   }
-  if (!sim && (!o.svg.empty() || !o.png.empty() || !o.waveform.empty() || o.faults > 0 ||
-               o.sim_cost != "none")) {
-    throw InputError("--svg, --png, --waveform, --faults and --sim-cost are for --device sim");
+  const bool drawing_out = !o.svg.empty() || !o.png.empty() || !o.waveform.empty();
+  if (!sim && ((drawing_out && !o.dry_run) || o.faults > 0 || o.sim_cost != "none")) {
+    throw InputError(
+        "--svg, --png, --waveform, --faults and --sim-cost are for --device sim (--svg, --png "
+        "and --waveform also for --dry-run)");
   }
-  if (sim && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
-    throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000");
+  if ((sim || o.dry_run) && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
+    throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000" +
+                     (sim ? "" : " (--dry-run runs the simulated plotter)"));
   }
   ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);

@@ -4,6 +4,7 @@
 // and reports what happened.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -14,6 +15,8 @@ class App;
 }
 
 namespace fdsurf::host {
+
+struct MachineSchedule;  // runners/machine_schedule.h
 
 struct StreamOptions {
   std::string file;
@@ -67,6 +70,13 @@ struct StreamOptions {
   /// Do not wait for Enter between layers (the pen change); the runners
   /// also go on without waiting when stdin is not a terminal.
   bool no_pause = false;
+  /// --dry-run: run the job through the simulated plotter with these limits
+  /// and report machine time, distances, pen lifts and extent; whatever
+  /// --device says, nothing is opened (RunDryRun, runners/runner.h).
+  bool dry_run = false;
+  /// A real device's schedule in machine time for its progress line (set by
+  /// RunStream when the progress line shows; nullptr otherwise).
+  std::shared_ptr<const MachineSchedule> schedule;
 };
 
 /// Adds the options of `stream` to `command`.

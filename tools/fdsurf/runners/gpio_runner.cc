@@ -127,6 +127,7 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   }
   const InterruptGuard interrupts;
   GpioRig rig(*outputs, tick_hz, o.quiet);
+  rig.progress.SetSchedule(o.schedule.get());
   int code = 0;
   if (o.dims == 3) {
     auto device = std::make_unique<device::Device<3>>(tick_hz);

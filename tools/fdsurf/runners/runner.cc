@@ -156,6 +156,14 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
   if (machine_seconds > 0) {
     std::snprintf(rate, sizeof rate, "%.1f s machine time, %.0fx real time", machine_seconds,
                   wall > 0 ? machine_seconds / wall : 0.0);
+  } else if (schedule_ != nullptr) {
+    // The device has been on the next command since the count last changed.
+    if (executed != last_executed_ || !shown_) {
+      last_executed_ = executed;
+      executed_changed_ = now;
+    }
+    const double running = std::chrono::duration<double>(now - executed_changed_).count();
+    std::snprintf(rate, sizeof rate, "%s", DescribeTimeLeft(*schedule_, executed, running).c_str());
   } else {
     std::snprintf(rate, sizeof rate, "%.2f commands/s",
                   wall > 0 ? static_cast<double>(executed) / wall : 0.0);

@@ -24,6 +24,7 @@
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/host/toolpath.h"
+#include "machine_schedule.h"
 
 namespace fdsurf::host {
 
@@ -94,7 +95,8 @@ void CheckSpeedAgainstTicks(const StreamJob& job, std::uint32_t tick_hz, const S
 
 /// The progress line on stderr: the layer running (LayerLabel), a bar,
 /// commands executed, frames sent, and the rate (machine time over wall
-/// time for the simulator).
+/// time for the simulator); for a real device with a schedule (SetSchedule),
+/// the machine time elapsed and left instead of the rate.
 class ProgressLine {
  public:
   explicit ProgressLine(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
@@ -104,6 +106,8 @@ class ProgressLine {
 
   /// The layer that the next lines show ("" for none).
   void SetLayer(std::string label) { layer_ = std::move(label); }
+  /// The job's schedule (ScheduleJob), or nullptr for none; not owned.
+  void SetSchedule(const MachineSchedule* schedule) { schedule_ = schedule; }
 
   /// Redraws at most 10 times a second (and always when `force`).
   /// `machine_seconds` > 0 for a simulated device.
@@ -117,6 +121,9 @@ class ProgressLine {
   bool enabled_;
   bool shown_ = false;
   std::string layer_;
+  const MachineSchedule* schedule_ = nullptr;
+  std::uint64_t last_executed_ = 0;
+  Clock::time_point executed_changed_;
   Clock::time_point start_;
   Clock::time_point last_;
 };
@@ -128,5 +135,22 @@ int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                  const ToolpathOptions& drawing, const std::string& units);
 int RunUsb(const StreamOptions& o, const StreamJob& job);
 int RunGpio(const StreamOptions& o, const StreamJob& job);
+
+/// The tick rate a dry run assumes for o.device: --tick-hz when given, else
+/// the simulator's default (40000 Hz) or, for gpio, the GPIO runner's (10000).
+std::uint32_t DryRunTickHz(const StreamOptions& o);
+
+/// `stream --dry-run`: the job through the simulated plotter at
+/// DryRunTickHz with o's limits, no pause between layers, nothing opened;
+/// prints on stdout the machine time, the pen-down and pen-up distances, the
+/// pen lifts, the page extent drawn and the command count, and writes
+/// --svg/--png/--waveform when given (no comparison with the exact curves).
+/// 0; DeviceError when the simulated device refused the job.
+int RunDryRun(const StreamOptions& o, const StreamJob& job);
+
+/// The job's schedule in machine time (machine_schedule.h), from a quiet
+/// run on the simulated plotter at `tick_hz`; empty when that run did not
+/// finish (the real run will say why).
+MachineSchedule ScheduleJob(const StreamOptions& o, const StreamJob& job, std::uint32_t tick_hz);
 
 }  // namespace fdsurf::host

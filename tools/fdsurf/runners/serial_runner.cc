@@ -117,6 +117,7 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   const protocol::HelloReply hello = *loop.link().hello();
   const StreamJob fitted = FitJobToDevice(job, hello, name, o);
   ProgressLine progress(ShowProgress(o.quiet));
+  progress.SetSchedule(o.schedule.get());
   const int code = loop.Run(fitted, &progress);
   if (code != 0 || o.quiet) return code;
   const HostLinkStats& stats = loop.link().stats();

@@ -3,6 +3,8 @@
 // the drawing is compared with the exact curves and the recorded steps with
 // the machine's limits.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -64,10 +66,10 @@ std::size_t CommandBytes(const StreamJob& job) {
   return bytes;
 }
 
-sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o) {
+sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o, std::uint32_t tick_hz) {
   sim::PlotterOptions options;
   options.axes = o.dims;
-  if (o.tick_hz != 0) options.tick_hz = o.tick_hz;
+  if (tick_hz != 0) options.tick_hz = tick_hz;
   options.bytes_per_second = o.link_bytes_per_second;
   options.to_device = sim::FaultRates::All(o.faults);
   options.to_host = sim::FaultRates::All(o.faults);
@@ -76,16 +78,34 @@ sim::PlotterOptions PlotterOptionsFor(const StreamOptions& o) {
   return options;
 }
 
+// How StreamToPlotter runs the job: a run on the sim device shows the
+// progress line and pauses for the pen change; a dry run pauses for
+// nothing; a schedule for a real device's progress line shows nothing.
+struct PlotterRun {
+  bool show_progress = true;
+  bool pause_between_layers = true;
+  /// When set, filled with the machine time by which each command was
+  /// executed (to the millisecond of virtual time).
+  MachineSchedule* schedule = nullptr;
+};
+
+// Extends the schedule to `p.executed` commands, all done by `p.time_us`.
+void RecordExecuted(std::uint64_t executed, std::uint64_t time_us, MachineSchedule* schedule) {
+  while (schedule->executed_s.size() < executed) schedule->executed_s.push_back(time_us * 1e-6);
+}
+
 // Streams the job to the plotter until every command ran (or the link gave
 // up), with the progress line. Layer by layer: the commands of one layer are
 // sent, and only when the link reports them all executed and the device idle
 // (the pen is up before every layer start) is the pen change asked for and
 // the next layer sent. The machine's clock does not run during the pause.
 sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
-                               sim::SimulatedPlotter* plotter) {
+                               sim::SimulatedPlotter* plotter, const PlotterRun& how) {
   HostLink link(LinkOptions());
-  ProgressLine progress(ShowProgress(o.quiet));
+  ProgressLine progress(how.show_progress && ShowProgress(o.quiet));
   constexpr std::uint64_t kTimeLimitUs = 24ull * 3600 * 1'000'000;  // a day of machine time
+  // The progress line redraws at most 10 times a second of wall time anyway.
+  const std::uint64_t interval_us = how.schedule != nullptr ? 1'000 : 250'000;
   sim::RunResult run;
   for (std::size_t from = 0;;) {
     const std::size_t to = NextLayerBoundary(job, from);
@@ -94,14 +114,16 @@ sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
     run = plotter->Run(
         link, kTimeLimitUs,
         [&](const sim::RunProgress& p) {
+          if (how.schedule != nullptr) RecordExecuted(p.executed, p.time_us, how.schedule);
           progress.Show(p.executed, job.commands.size(), p.frames_sent, p.time_us * 1e-6);
         },
-        250'000);
+        interval_us);
     if (!run.finished || to == job.commands.size()) break;
     progress.Finish();
-    PauseForLayer(o.no_pause, job, to, run.executed);
+    if (how.pause_between_layers) PauseForLayer(o.no_pause, job, to, run.executed);
     from = to;
   }
+  if (how.schedule != nullptr) RecordExecuted(run.executed, run.time_us, how.schedule);
   progress.Show(run.executed, job.commands.size(), run.host.frames_sent, run.time_us * 1e-6, true);
   progress.Finish();
   return run;
@@ -248,15 +270,129 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
 
 int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
                  const ToolpathOptions& drawing, const std::string& units) {
-  const sim::PlotterOptions plotter_options = PlotterOptionsFor(o);
+  const sim::PlotterOptions plotter_options = PlotterOptionsFor(o, o.tick_hz);
   CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
   sim::SimulatedPlotter plotter(plotter_options);
-  const sim::RunResult run = StreamToPlotter(o, job, &plotter);
+  const sim::RunResult run = StreamToPlotter(o, job, &plotter, PlotterRun{});
   if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
   const CheckedDrawing checked = CheckDrawing(plotter, set, job, plotter_options.tick_hz, o.dims);
   WriteDrawing(o, job, plotter, checked.drawn);
   if (!o.quiet) PrintReport(o, set, job, drawing, units, plotter_options, run, checked);
   return checked.within && checked.limits_kept ? 0 : 1;
+}
+
+namespace {
+
+// What a dry run measures of the recorded motion. Distances are the motors':
+// a step of two axes at once counts √2 steps (as the summary's path length).
+struct DryRunFigures {
+  double machine_s = 0;  // the last step, as CheckMotion's duration
+  double pen_down_steps = 0;
+  double pen_up_steps = 0;
+  std::size_t pen_lifts = 0;
+  std::array<std::int64_t, 3> lo{}, hi{};  // the positions drawn (pen down)
+  bool drew = false;
+};
+
+DryRunFigures MeasureDryRun(const sim::SimulatedPlotter& plotter,
+                            const std::vector<sim::DrawnPath>& drawn) {
+  DryRunFigures f;
+  double total = 0;
+  for (const hal::StepDirEvent& e : plotter.step_events()) {
+    if (e.axis_mask == 0) continue;
+    total += std::sqrt(static_cast<double>(__builtin_popcount(e.axis_mask)));
+    f.machine_s = e.time_us * 1e-6;
+  }
+  for (const sim::DrawnPath& path : drawn) {
+    for (std::size_t k = 0; k < path.points.size(); ++k) {
+      const auto& p = path.points[k];
+      for (int c = 0; c < 3; ++c) {
+        f.lo[c] = f.drew ? std::min(f.lo[c], p[c]) : p[c];
+        f.hi[c] = f.drew ? std::max(f.hi[c], p[c]) : p[c];
+      }
+      f.drew = true;
+      if (k == 0) continue;
+      const auto& q = path.points[k - 1];
+      f.pen_down_steps +=
+          std::hypot(static_cast<double>(p[0] - q[0]), static_cast<double>(p[1] - q[1]),
+                     static_cast<double>(p[2] - q[2]));
+    }
+  }
+  f.pen_up_steps = std::max(0.0, total - f.pen_down_steps);
+  for (const hal::PenEvent& pen : plotter.pen_events()) f.pen_lifts += pen.down ? 0 : 1;
+  return f;
+}
+
+// Where the dry run's tick rate came from, for its first line.
+std::string TickSource(const StreamOptions& o) {
+  if (o.tick_hz != 0) return "--tick-hz";
+  if (o.device == "sim") return "the simulator's default";
+  if (o.device.rfind("gpio:", 0) == 0) return "the GPIO runner's default";
+  return "assumed: a real device's own rate is known only after HELLO; give --tick-hz";
+}
+
+void PrintDryRun(const StreamOptions& o, const StreamJob& job, std::uint32_t tick_hz,
+                 const DryRunFigures& f) {
+  const double step = job.page.quantum.value();
+  const char* units = o.units.c_str();
+  std::printf(
+      "%s: dry run of %s on the simulated plotter (%d axes, %u Hz ticks, %s); nothing "
+      "sent to %s\n",
+      o.file.c_str(), JobContents(job).c_str(), o.dims, tick_hz, TickSource(o).c_str(),
+      o.device.c_str());
+  std::printf("machine time: %.1f s (%s)\n", f.machine_s, FormatClock(f.machine_s).c_str());
+  std::printf("pen down: %.1f %s, pen up (travel): %.1f %s, %zu pen lift%s\n",
+              f.pen_down_steps * step, units, f.pen_up_steps * step, units, f.pen_lifts,
+              f.pen_lifts == 1 ? "" : "s");
+  if (f.drew) {
+    std::string extent = "page extent drawn: x " + FormatNumber(f.lo[0] * step) + ".." +
+                         FormatNumber(f.hi[0] * step) + ", y " + FormatNumber(f.lo[1] * step) +
+                         ".." + FormatNumber(f.hi[1] * step);
+    if (o.dims == 3) {
+      extent += ", z " + FormatNumber(f.lo[2] * step) + ".." + FormatNumber(f.hi[2] * step);
+    }
+    std::printf("%s %s\n", extent.c_str(), units);
+  } else {
+    std::printf("page extent drawn: nothing drawn\n");
+  }
+  std::printf("commands: %zu; limits %s %s/s, %s %s/s², pen delay %d ms\n", job.commands.size(),
+              FormatNumber(o.speed).c_str(), units, FormatNumber(o.accel).c_str(), units,
+              o.pen_delay_ms);
+}
+
+}  // namespace
+
+std::uint32_t DryRunTickHz(const StreamOptions& o) {
+  if (o.tick_hz != 0) return o.tick_hz;
+  if (o.device.rfind("gpio:", 0) == 0) return 10000;
+  return sim::PlotterOptions{}.tick_hz;
+}
+
+int RunDryRun(const StreamOptions& o, const StreamJob& job) {
+  const std::uint32_t tick_hz = DryRunTickHz(o);
+  const sim::PlotterOptions plotter_options = PlotterOptionsFor(o, tick_hz);
+  CheckSpeedAgainstTicks(job, tick_hz, o);
+  sim::SimulatedPlotter plotter(plotter_options);
+  PlotterRun how;
+  how.pause_between_layers = false;
+  const sim::RunResult run = StreamToPlotter(o, job, &plotter, how);
+  if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
+  const std::vector<sim::DrawnPath> drawn = plotter.DrawnPaths();
+  WriteDrawing(o, job, plotter, drawn);
+  PrintDryRun(o, job, tick_hz, MeasureDryRun(plotter, drawn));
+  return 0;
+}
+
+MachineSchedule ScheduleJob(const StreamOptions& o, const StreamJob& job, std::uint32_t tick_hz) {
+  sim::SimulatedPlotter plotter(PlotterOptionsFor(o, tick_hz));
+  MachineSchedule schedule;
+  schedule.tick_hz = plotter.options().tick_hz;
+  PlotterRun how;
+  how.show_progress = false;
+  how.pause_between_layers = false;
+  how.schedule = &schedule;
+  if (!StreamToPlotter(o, job, &plotter, how).finished) return {};
+  return schedule;
 }
 
 }  // namespace fdsurf::host

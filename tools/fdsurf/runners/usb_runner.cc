@@ -32,6 +32,7 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
   if (!loop.Connect()) return 130;
   const StreamJob fitted = FitJobToDevice(job, *loop.link().hello(), options.device, o);
   ProgressLine progress(ShowProgress(o.quiet));
+  progress.SetSchedule(o.schedule.get());
   const int code = loop.Run(fitted, &progress);
   if (code != 0 || o.quiet) return code;
   std::fprintf(stderr, "%s: %s drawn by usb %s; %llu frames sent (%llu resent)\n", o.file.c_str(),
