@@ -234,4 +234,23 @@ TEST_F(StreamCurves, ASingleLayerDoesNotPause) {
 }
 
 }  // namespace
+// With no --travel the device's travel is the page's, rounded up to whole
+// steps: the torus of closed-nets.json reaches 3818.66 steps of depth on a
+// 60x60 page, a point at 3819, which a travel rounded down refused.
+TEST_F(StreamCurves, TheDefaultTravelHoldsADepthOfNoWholeSteps) {
+  const PatchSet set = ReadPatchFile(std::string(FDSURF_EXAMPLES_DIR) + "/closed-nets.json");
+  ToolpathOptions t;
+  t.view = *NamedView("iso");
+  t.fit = std::array<double, 2>{60, 60};
+  t.origin = PageOrigin::kCenter;
+  t.margin = 5;
+  t.dims = 3;
+  t.mode = StepMode::kStepExact;
+  const MachineOptions machine;
+  const StreamJob job = BuildStreamJob(set, t, machine, "mm");
+  const double depth_steps = job.page.depth / machine.step.value();
+  EXPECT_NE(depth_steps, std::floor(depth_steps));  // the case this is about
+  EXPECT_EQ(job.config.travel_steps[2], static_cast<std::int32_t>(std::ceil(depth_steps)));
+}
+
 }  // namespace fdsurf::host

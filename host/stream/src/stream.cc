@@ -53,9 +53,13 @@ std::array<Vec, 2> Ends(const Patch& patch, const StreamJob& job, int lines_s, i
   return {start, InSteps(patch, job, 1, reversed ? 0 : 1)};
 }
 
+// A machine's travel (`round_up` false) holds its whole steps only; the
+// page's, when no travel is given (`round_up` true), holds the page: a line
+// that reaches the page's exact edge at 3818.66 steps draws a point at 3819.
 std::int32_t TravelSteps(double length, const Quantum& step, const std::string& units,
-                         const std::string& field) {
-  const double steps = std::floor(length / step.value() + 1e-9);
+                         const std::string& field, bool round_up) {
+  const double exact = length / step.value();
+  const double steps = round_up ? std::ceil(exact - 1e-9) : std::floor(exact + 1e-9);
   if (!(steps >= 1)) {
     throw OptionError(field, FormatNumber(length) + " " + units,
                       "is less than one step of " + step.Format(1) + " " + units);
@@ -91,7 +95,8 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
       throw OptionError(fields[c], FormatNumber(travel) + " " + units,
                         "is smaller than the page (" + FormatNumber(extent[c]) + " " + units + ")");
     }
-    config.travel_steps[c] = TravelSteps(travel, machine.step, units, fields[c]);
+    config.travel_steps[c] = TravelSteps(travel, machine.step, units, fields[c],
+                                         /*round_up=*/!(machine.travel[c] > 0));
     const double meters = step * (units == "in" ? 0.0254 : 0.001);
     config.steps_per_meter[c] = static_cast<std::uint32_t>(std::lround(1 / meters));
   }
