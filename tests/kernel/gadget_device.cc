@@ -202,7 +202,7 @@ SpeedDescriptors SpeedSet(uint16_t max_packet) {
 // of it, so each ends with a short packet.
 size_t ShortChunk(size_t size) {
   const size_t chunk = std::min<size_t>(size, 511);
-  return chunk % 64 == 0 ? chunk - 1 : chunk;
+  return chunk != 0 && chunk % 64 == 0 ? chunk - 1 : chunk;
 }
 
 // The gadget side of the vendor interface over FunctionFS. Endpoint reads

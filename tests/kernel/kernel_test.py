@@ -89,6 +89,7 @@ start_gadget() {
   while ! grep -q ready /tmp/ready 2>/dev/null && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
   echo $UDC > $G/UDC
   wait_for /sys/bus/usb/devices/1-1:1.0 10
+  echo "FDSURF-RESULT endpoints $(cd /sys/bus/usb/devices/1-1:1.0 && echo ep_*)"
   sleep 0.3
 }
 DEVICE=usb:%(vid_pid)s
