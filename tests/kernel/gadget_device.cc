@@ -16,7 +16,8 @@
 // written, so the gadget can be bound to the UDC). On SIGTERM or the time
 // limit it writes FILE (key value lines: executed commands, accepted
 // commands, duplicates, HELLOs, steps per axis, the final position, a
-// digest of every step and pen change in order, pen state, idle) and exits 0.
+// digest of every step and pen change in order, pen state, idle, FunctionFS
+// ENABLE events, tty hang-ups) and exits 0.
 // On SIGUSR1 it writes FILE as it is now and goes on. FILE is renamed into
 // place, so a reader never sees half of one.
 #include <fcntl.h>
@@ -112,14 +113,19 @@ class Link {
   virtual void Wait() = 0;
 };
 
-// The gadget side of CDC-ACM: a tty, raw, non-blocking.
+// The gadget side of CDC-ACM: a tty, raw, non-blocking. When the gadget
+// is unbound from its UDC the kernel hangs this tty up (u_serial's
+// disconnect): reads then return 0 and the file must be opened again.
 class TtyLink final : public Link {
  public:
   bool Open(const std::string& path) {
+    path_ = path;
     fd_ = open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
     if (fd_ < 0) {
-      std::fprintf(stderr, "gadget_device: cannot open %s: %s\n", path.c_str(),
-                   std::strerror(errno));
+      if (hangups_ == 0) {
+        std::fprintf(stderr, "gadget_device: cannot open %s: %s\n", path.c_str(),
+                     std::strerror(errno));
+      }
       return false;
     }
     termios tio{};
@@ -132,11 +138,20 @@ class TtyLink final : public Link {
     if (fd_ >= 0) close(fd_);
   }
   size_t Receive(uint8_t* data, size_t capacity) override {
+    if (fd_ < 0 && !Open(path_)) return 0;
     const ssize_t n = read(fd_, data, capacity);
-    return n > 0 ? static_cast<size_t>(n) : 0;
+    if (n > 0) return static_cast<size_t>(n);
+    if (n == 0 || (errno != EAGAIN && errno != EINTR)) {
+      ++hangups_;
+      close(fd_);
+      fd_ = -1;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return 0;
   }
+  uint32_t hangups() const { return hangups_; }
   void Send(const uint8_t* data, size_t size) override {
-    while (size > 0 && !g_quit) {
+    while (size > 0 && fd_ >= 0 && !g_quit) {
       const ssize_t n = write(fd_, data, size);
       if (n > 0) {
         data += n;
@@ -151,11 +166,13 @@ class TtyLink final : public Link {
   }
   void Wait() override {
     pollfd p{fd_, POLLIN, 0};
-    (void)poll(&p, 1, 1);
+    (void)poll(&p, fd_ >= 0 ? 1 : 0, 1);
   }
 
  private:
+  std::string path_;
   int fd_ = -1;
+  uint32_t hangups_ = 0;
 };
 
 // The FunctionFS descriptors: full and high speed, each one vendor-specific
@@ -400,7 +417,7 @@ struct Run {
     ticks_done = std::max(ticks_done, due > 100000 ? due - 100000 : 0);
   }
 
-  void Report(uint32_t enables) const {
+  void Report(uint32_t enables, uint32_t hangups) const {
     const std::string temporary = o.report + ".new";
     FILE* f = std::fopen(temporary.c_str(), "w");
     if (f == nullptr) return;
@@ -413,8 +430,9 @@ struct Run {
                  static_cast<long long>(outputs.position[0]),
                  static_cast<long long>(outputs.position[1]),
                  static_cast<unsigned long long>(outputs.digest));
-    std::fprintf(f, "pen_down %d\nidle %d\nbytes_in %llu\nenables %u\n", outputs.pen_down ? 1 : 0,
-                 device.Idle() ? 1 : 0, static_cast<unsigned long long>(bytes_in), enables);
+    std::fprintf(f, "pen_down %d\nidle %d\nbytes_in %llu\nenables %u\nhangups %u\n",
+                 outputs.pen_down ? 1 : 0, device.Idle() ? 1 : 0,
+                 static_cast<unsigned long long>(bytes_in), enables, hangups);
     std::fclose(f);
     std::rename(temporary.c_str(), o.report.c_str());
   }
@@ -447,9 +465,9 @@ int main(int argc, char** argv) {
     run->Service();
     run->device.Fill();
     run->Tick(start);
-    if (g_snapshot.exchange(false)) run->Report(ffs.enables());
+    if (g_snapshot.exchange(false)) run->Report(ffs.enables(), tty.hangups());
   }
-  run->Report(ffs.enables());
+  run->Report(ffs.enables(), tty.hangups());
   // The FunctionFS threads are blocked in the kernel; leave without joining.
   std::fflush(nullptr);
   _exit(0);

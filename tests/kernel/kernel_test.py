@@ -136,6 +136,8 @@ while ! grep -q "^executed [1-9]" /tmp/report 2>/dev/null && [ $i -lt 200 ]; do
   kill -USR1 $GADGET 2>/dev/null; sleep 0.05; i=$((i+1))
 done
 sleep 1
+rm -f /tmp/report; kill -USR1 $GADGET; sleep 0.2
+echo "FDSURF-RESULT executed_at_unbind $(sed -n 's/^executed //p' /tmp/report)"
 echo "" > $G/UDC
 echo "FDSURF-RESULT unbound 1"
 i=0
@@ -249,8 +251,12 @@ def check(klass, case, results, references):
         expect(f"{job}.idle", "1")
     if case == "rebind":
         expect("unbound", "1")
-        if klass == "ffs":
-            expect("teapot.enables", "2")
+        at_unbind = results.get("executed_at_unbind", "")
+        if not (at_unbind.isdigit() and 0 < int(at_unbind) < int(references["teapot"]["commands"])):
+            problems.append(f"unbound after {at_unbind!r} commands executed: not mid-stream")
+        # The gadget saw the unbind: FunctionFS ENABLEs again, the ACM tty hangs up.
+        expect("teapot.enables" if klass == "ffs" else "teapot.hangups", "2" if klass == "ffs" else "1")
+        expect("teapot.duplicates", "0")
         stderr = results.get("teapot.stderr", "")
         if "resum" not in stderr and "reconnect" not in stderr and "back" not in stderr:
             problems.append(f"teapot.stderr says nothing of the reattach: {stderr!r}")
