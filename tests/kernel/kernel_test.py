@@ -40,6 +40,13 @@ TICK_HZ = 20000
 SPEEDUP = 20
 
 GADGET_COMMON = """
+bind() {  # the UDC refuses a bind while a previous unbind is still settling
+  i=0
+  until echo $UDC > $G/UDC 2>/dev/null; do
+    i=$((i + 1)); [ $i -lt 40 ] || { echo "FDSURF-ERROR cannot bind to $UDC"; return 1; }
+    sleep 0.1
+  done
+}
 G=/sys/kernel/config/usb_gadget/fdsurf
 mkdir $G
 echo 0x1209 > $G/idVendor
@@ -68,7 +75,7 @@ start_gadget() {
     --speedup %(speedup)d $1 > /tmp/ready &
   GADGET=$!
   wait_for /dev/ttyGS0 5
-  echo $UDC > $G/UDC
+  bind
   wait_for /sys/bus/usb/devices/1-1 10
   wait_for /dev/ttyACM0 10
 }
@@ -87,7 +94,7 @@ start_gadget() {
   GADGET=$!
   i=0
   while ! grep -q ready /tmp/ready 2>/dev/null && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
-  echo $UDC > $G/UDC
+  bind
   wait_for /sys/bus/usb/devices/1-1:1.0 10
   echo "FDSURF-RESULT endpoints $(cd /sys/bus/usb/devices/1-1:1.0 && echo ep_*)"
   sleep 0.3
@@ -104,13 +111,16 @@ def stream_command(job, device, extra=""):
 
 
 def stop_gadget(prefix):
+    # Unbound first, then stopped: a FunctionFS gadget whose ep0 closes while
+    # bound is torn down by the kernel on its own, and the next bind could
+    # meet that teardown half done.
     return f"""
-kill $GADGET; wait $GADGET
-report {prefix} /tmp/report
-rm -f /tmp/report
 echo "" > $G/UDC
 i=0
 while [ -e $GONE ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
+kill $GADGET; wait $GADGET
+report {prefix} /tmp/report
+rm -f /tmp/report
 """
 
 
@@ -143,7 +153,7 @@ echo "FDSURF-RESULT unbound 1"
 i=0
 while [ -e $GONE ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i+1)); done
 sleep 0.5
-echo $UDC > $G/UDC
+bind
 wait $HOST
 echo "FDSURF-RESULT teapot.exit $?"
 echo "FDSURF-RESULT teapot.stderr $(tr '\\r' '\\n' < /tmp/stderr | grep -v '^fdsurf: \\[' | tr '\\n' '|')"
