@@ -99,7 +99,7 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
     Fold(down ? 0x81 : 0x80);
     return fdsurf::hal::IoStatus::kOk;
   }
-  const char* DoLastError() const override { return ""; }
+  FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
   uint8_t negative_ = 0;
 };
 
@@ -149,7 +149,7 @@ class TtyLink final : public Link {
     }
     return 0;
   }
-  uint32_t hangups() const { return hangups_; }
+  FDSURF_NODISCARD uint32_t hangups() const { return hangups_; }
   void Send(const uint8_t* data, size_t size) override {
     while (size > 0 && fd_ >= 0 && !g_quit) {
       const ssize_t n = write(fd_, data, size);
@@ -276,7 +276,7 @@ class FfsLink final : public Link {
   }
   void Wait() override { std::this_thread::sleep_for(std::chrono::microseconds(500)); }
 
-  uint32_t enables() const { return enables_; }
+  FDSURF_NODISCARD uint32_t enables() const { return enables_; }
 
  private:
   bool Error(const std::string& what) {
