@@ -30,6 +30,9 @@ packages=(
   gcc-avr avr-libc binutils-avr
   qemu-system-arm qemu-system-misc
   simavr libsimavr-dev libelf-dev
+  # The USB stack of a real Debian kernel under QEMU (tests/kernel/README.md):
+  # the guest's shell and the emulator; umockdev for the libusb error paths.
+  qemu-system-x86 busybox-static umockdev libumockdev-dev
 )
 # The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.
 # Debian's nodejs + npm provide node; a machine that already has a node with

@@ -11,7 +11,10 @@ jobs=$(nproc)
 echo "== build (Release) and test, with every microcontroller image under its emulator"
 bash scripts/setup.sh
 # Includes the Target.* tests: each builds a cross target in build/targets/<target>
-# and runs its image under QEMU or simavr against the host reference.
+# and runs its image under QEMU or simavr against the host reference, and the
+# label `kernel` (tests/kernel/): Debian's kernel under QEMU, its USB stack with
+# the firmware as a gadget (the kernel package is fetched once by apt-get
+# download into build/tests/kernel/kernel-cache). Not in the sanitizer build.
 ctest --test-dir build --output-on-failure --parallel "$jobs"
 
 echo "== Debian package of the tool: cpack, install, run, remove"

@@ -385,6 +385,19 @@ UsbTransport::Match UsbTransport::TryDevice(libusb_device* device,
   return Match::kTaken;
 }
 
+// libusb keeps its device list current from udev's hotplug events; without
+// a udev daemon (an initramfs, most containers) the list stays as it was at
+// libusb_init, and a device that comes back is never seen (found against
+// the real kernel, tests/kernel/). A new context enumerates sysfs afresh.
+// Only while no handle is open; if libusb_init fails the old one stays.
+void UsbTransport::RenewContext() {
+  if (handle_ != nullptr) return;
+  libusb_context* fresh = nullptr;
+  if (libusb_init(&fresh) != 0) return;
+  libusb_exit(context_);
+  context_ = fresh;
+}
+
 void UsbTransport::CloseHandle() {
   if (handle_ == nullptr) return;
   // Fails harmlessly (LIBUSB_ERROR_NO_DEVICE) when the device is gone.
@@ -471,6 +484,7 @@ IoStatus UsbTransport::DoReconnect(uint32_t timeout_ms) {
   if (handle_ != nullptr) return IoStatus::kOk;
   const auto deadline = SteadyClock::now() + std::chrono::milliseconds(timeout_ms);
   while (true) {
+    RenewContext();
     std::string error;
     const IoStatus status = Attach(true, &error);
     if (status == IoStatus::kOk) return IoStatus::kOk;

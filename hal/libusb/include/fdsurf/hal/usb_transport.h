@@ -113,6 +113,8 @@ class UsbTransport final : public Transport {
   Match TryDevice(libusb_device* device, const libusb_device_descriptor& descriptor,
                   bool reconnecting, IoStatus* status, std::string* error);
   void CloseHandle();
+  // A fresh libusb context (a new enumeration) while disconnected.
+  void RenewContext();
   IoStatus Fail(IoStatus status, std::string detail);
   IoStatus TransferError(int rc, const char* what, const std::string& progress);
 
