@@ -30,7 +30,17 @@ packages=(
   gcc-avr avr-libc binutils-avr
   qemu-system-arm qemu-system-misc
   simavr libsimavr-dev libelf-dev
+  # GPIO on arm64 under QEMU (tests/kernel/arm64/): the cross compiler and
+  # libgpiod for arm64 (multiarch, below); qemu-system-aarch64 is in
+  # qemu-system-arm. The guest's kernel and busybox are extracted from their
+  # .deb files into the build tree (tests/kernel/arm64/fetch_guest.sh).
+  g++-aarch64-linux-gnu libgpiod-dev:arm64
 )
+# The arm64 packages above need dpkg to know the architecture (and apt its
+# package lists, which the update below fetches when something is missing).
+if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  dpkg --add-architecture arm64
+fi
 # The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.
 # Debian's nodejs + npm provide node; a machine that already has a node with
 # npm bundled (e.g. from NodeSource) keeps it.
@@ -58,3 +68,5 @@ build_dir=${FDSURF_BUILD_DIR:-build}
 build_type=${FDSURF_BUILD_TYPE:-Release}
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" ${FDSURF_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build_dir" --parallel "$(nproc)"
+# The guest of the GPIO test under QEMU arm64 (CTest label kernel).
+bash tests/kernel/arm64/fetch_guest.sh "$build_dir/kernel-arm64"
