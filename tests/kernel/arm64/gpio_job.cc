@@ -35,7 +35,7 @@ struct Options {
   std::string input;
   std::string job;
   std::string reference;
-  std::string step = "0.1";
+  std::string step = "0.05";
   double speed = 20;
   double accel = 400;
   std::uint32_t tick_hz = 2000;
