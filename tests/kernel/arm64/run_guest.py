@@ -86,7 +86,9 @@ INIT_ERRORS = r"""
 # lines while the first streams (it requests them all before its first tick).
 /bin/fdsurf-gpio-stream /job --device {device} --tick-hz {tick_hz} --quiet 2>/tmp/holder &
 holder=$!
-sleep 1
+# Until the kernel lists the holder as its lines' consumer (debugfs), 20 s at most.
+for i in $(seq 200); do grep -q '|fdsurf' /sys/kernel/debug/gpio && break; sleep 0.1; done
+sed 's/^/FDSURF-HELD /' /sys/kernel/debug/gpio
 run busy /bin/fdsurf-gpio-stream /job --device {device} --tick-hz {tick_hz}
 wait $holder; result holder $?
 run no_chip /bin/fdsurf-gpio-stream /job --device gpio:gpiochip9:0,1,2,4,5,6
@@ -123,7 +125,8 @@ def build_initramfs(args, init_text, path):
     files = [(n, d, b"") for n in ("bin", "dev", "proc", "sys", "tmp", "etc")]
     files += [("bin/busybox", x, read(os.path.join(args.cache, "busybox"))),
               ("gpio_keys.ko", r, read(os.path.join(args.cache, "gpio_keys.ko")))]
-    for tool in ("sh", "mount", "sed", "ls", "sleep", "chmod", "su", "poweroff", "cat", "insmod"):
+    for tool in ("sh", "mount", "sed", "ls", "sleep", "chmod", "su", "poweroff", "cat", "insmod",
+                 "grep", "seq"):
         files.append(("bin/" + tool, stat.S_IFLNK | 0o777, b"busybox"))
     files += [("bin/fdsurf-gpio-stream", x, read(args.streamer)),
               ("job", r, read(args.job)),
