@@ -36,9 +36,9 @@ struct Options {
   std::string job;
   std::string reference;
   std::string step = "0.05";
-  double speed = 20;
+  double speed = 10;
   double accel = 400;
-  std::uint32_t tick_hz = 2000;
+  std::uint32_t tick_hz = 500;
 };
 
 StreamJob PlanJob(const Options& o) {

@@ -295,7 +295,7 @@ def main():
     parser.add_argument("--checker", help="fdsurf_waveform_check")
     parser.add_argument("--out", required=True, help="where the console, trace and waveform go")
     parser.add_argument("--qemu", default="qemu-system-aarch64")
-    parser.add_argument("--tick-hz", type=int, default=2000)
+    parser.add_argument("--tick-hz", type=int, default=500)
     parser.add_argument("--timeout", type=float, default=120)
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
