@@ -88,9 +88,9 @@ void WriteReference(const StreamJob& job, const Options& o) {
   sim::WaveformWriteOptions write;
   write.axes = job.config.axes;
   std::ofstream out(o.reference, std::ios::binary);
-  sim::WriteWaveform(out, header,
-                     sim::TransitionsFromEvents(header, plotter.step_events(),
-                                                plotter.pen_events(), write));
+  sim::WriteWaveform(
+      out, header,
+      sim::TransitionsFromEvents(header, plotter.step_events(), plotter.pen_events(), write));
   out.close();
   if (!out) throw OutputError(o.reference + ": cannot write the waveform");
   std::size_t moves = 0;

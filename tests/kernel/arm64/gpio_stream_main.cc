@@ -95,14 +95,14 @@ StreamJob ReadJob(const std::string& path) {
     const auto byte = static_cast<std::uint8_t>(bytes[k]);
     const bool complete = decoder.OnByte(byte);
     if (byte != 0) continue;
-    const std::string where = path + ": frame " + std::to_string(job.commands.size()) +
-                              " (byte " + std::to_string(frame_start) + ")";
+    const std::string where = path + ": frame " + std::to_string(job.commands.size()) + " (byte " +
+                              std::to_string(frame_start) + ")";
     if (!complete) throw InputError(where + ": not a valid frame (COBS or CRC)");
     protocol::Command command;
     const protocol::DecodeResult result = protocol::DecodeCommand(decoder.frame(), &command);
     if (!result.ok()) {
-      throw InputError(where + ": not a command: " + protocol::ErrorName(result.code) +
-                       " (field " + std::to_string(result.field) + ")");
+      throw InputError(where + ": not a command: " + protocol::ErrorName(result.code) + " (field " +
+                       std::to_string(result.field) + ")");
     }
     if (job.commands.empty() && command.type != protocol::MessageType::kConfig) {
       throw InputError(where + ": the first command must be the CONFIG");
