@@ -68,5 +68,6 @@ build_dir=${FDSURF_BUILD_DIR:-build}
 build_type=${FDSURF_BUILD_TYPE:-Release}
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" ${FDSURF_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build_dir" --parallel "$(nproc)"
-# The guest of the GPIO test under QEMU arm64 (CTest label kernel).
-bash tests/kernel/arm64/fetch_guest.sh "$build_dir/kernel-arm64"
+# The guest of the GPIO test under QEMU arm64 (CTest label kernel), where
+# its fixture (tests/kernel/arm64/CMakeLists.txt) looks for it.
+bash tests/kernel/arm64/fetch_guest.sh "$build_dir/tests/kernel/arm64/guest"
