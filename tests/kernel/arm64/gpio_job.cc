@@ -103,7 +103,9 @@ void WriteReference(const StreamJob& job, const Options& o) {
 }  // namespace
 }  // namespace fdsurf::host
 
-int main(int argc, char** argv) {
+namespace {
+
+int Main(int argc, char** argv) {
   fdsurf::host::Options o;
   CLI::App app("Plans a job for fdsurf-gpio-stream and the simulated plotter's waveform of it");
   app.add_option("--input", o.input, "the drawing (any format fdsurf reads)")->required();
@@ -125,6 +127,17 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fdsurf_kernel_gpio_job: error: %s\n", e.what());
+    return 2;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (...) {
+    std::fprintf(stderr, "fdsurf_kernel_gpio_job: error: an unexpected exception\n");
     return 2;
   }
 }
