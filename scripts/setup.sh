@@ -33,7 +33,17 @@ packages=(
   # The USB stack of a real Debian kernel under QEMU (tests/kernel/README.md):
   # the guest's shell and the emulator; umockdev for the libusb error paths.
   qemu-system-x86 busybox-static umockdev libumockdev-dev
+  # GPIO on arm64 under QEMU (tests/kernel/arm64/): the cross compiler and
+  # libgpiod for arm64 (multiarch, below); qemu-system-aarch64 is in
+  # qemu-system-arm. The guest's kernel and busybox are extracted from their
+  # .deb files into the build tree (tests/kernel/arm64/fetch_guest.sh).
+  g++-aarch64-linux-gnu libgpiod-dev:arm64
 )
+# The arm64 packages above need dpkg to know the architecture (and apt its
+# package lists, which the update below fetches when something is missing).
+if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  dpkg --add-architecture arm64
+fi
 # The G-code read-back check uses the npm packages gcode-toolpath/gcode-parser.
 # Debian's nodejs + npm provide node; a machine that already has a node with
 # npm bundled (e.g. from NodeSource) keeps it.
@@ -61,3 +71,9 @@ build_dir=${FDSURF_BUILD_DIR:-build}
 build_type=${FDSURF_BUILD_TYPE:-Release}
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" ${FDSURF_CMAKE_ARGS:-} >/dev/null
 cmake --build "$build_dir" --parallel "$(nproc)"
+# The guest of the GPIO test under QEMU arm64 (CTest label kernel), where
+# its fixture (tests/kernel/arm64/CMakeLists.txt) looks for it; sanitizer
+# builds do not run it.
+if ! grep -q '^FDSURF_SANITIZE:BOOL=ON' "$build_dir/CMakeCache.txt"; then
+  bash tests/kernel/arm64/fetch_guest.sh "$build_dir/tests/kernel/arm64/guest"
+fi
