@@ -72,7 +72,8 @@ protocol::Command QuarterCircle(double cx, double cy, double r, double a0) {
 // Pen down, a circle of four quarters, pen up: 6 commands after the config.
 std::vector<protocol::Command> CircleJob() {
   std::vector<protocol::Command> job = {ConfigCommand(), PenCommand(true)};
-  for (int q = 0; q < 4; ++q) job.push_back(QuarterCircle(2000, 2000, 1500, q * 1.5707963267948966));
+  for (int q = 0; q < 4; ++q)
+    job.push_back(QuarterCircle(2000, 2000, 1500, q * 1.5707963267948966));
   job.push_back(PenCommand(false));
   return job;
 }

@@ -742,8 +742,8 @@ TEST(HostLink, VersionMismatchFails) {
                            reply.size()));
   link.OnBytes(reply.data(), reply.size(), 10);
   ASSERT_TRUE(link.Failed());
-  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host " +
-                              std::to_string(kProtocolVersion));
+  EXPECT_EQ(link.error(),
+            "protocol version mismatch: device speaks 1, host " + std::to_string(kProtocolVersion));
 }
 
 TEST(HostLink, StopIsSentUntilAcknowledged) {

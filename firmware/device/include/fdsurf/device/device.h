@@ -498,10 +498,10 @@ class Device {
   uint32_t executed_;
   motion::ValidationWork validation_work_ = {0, 0};
   PausePhase pause_ = PausePhase::kNone;
-  uint32_t pause_wait_ = 0;              // pen delay ticks left in kLifting/kLowering
-  bool pen_lifted_by_pause_ = false;     // the pen is up only because of the pause
-  bool lower_pending_ = false;           // kLowering: the pen is yet to be lowered
-  bool halt_outputs_ = false;            // HALT: pen up and drivers off on the next tick
+  uint32_t pause_wait_ = 0;           // pen delay ticks left in kLifting/kLowering
+  bool pen_lifted_by_pause_ = false;  // the pen is up only because of the pause
+  bool lower_pending_ = false;        // kLowering: the pen is yet to be lowered
+  bool halt_outputs_ = false;         // HALT: pen up and drivers off on the next tick
 };
 
 }  // namespace device

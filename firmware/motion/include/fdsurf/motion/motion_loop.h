@@ -121,9 +121,7 @@ class MotionLoop {
   void Resume() { pausing_ = false; }
   FDSURF_NODISCARD bool Pausing() const { return pausing_; }
   /// Paused and at rest: nothing moves until Resume().
-  FDSURF_NODISCARD bool HeldAtPause() const {
-    return pausing_ && speed_ == 0 && pen_wait_ == 0;
-  }
+  FDSURF_NODISCARD bool HeldAtPause() const { return pausing_ && speed_ == 0 && pen_wait_ == 0; }
 
   /// Forgets the buffer and the motion state (the caller has made sure the
   /// machine is at rest). Position and counters are kept.

@@ -66,9 +66,9 @@ struct DeviceLinkStats {
   uint32_t hellos;             ///< HELLOs answered (new session or resume)
   uint32_t status_queries;
   uint32_t stops;
-  uint32_t pauses;   ///< PAUSE frames handled (repeats included)
-  uint32_t resumes;  ///< RESUME frames handled
-  uint32_t halts;    ///< HALT frames handled
+  uint32_t pauses;           ///< PAUSE frames handled (repeats included)
+  uint32_t resumes;          ///< RESUME frames handled
+  uint32_t halts;            ///< HALT frames handled
   uint32_t replies_dropped;  ///< no room in the output buffer
   /// Frames with the plain CRC that need a session (all but HELLO), or any
   /// frame but HELLO before the first session: dropped unanswered. Frames of
