@@ -153,6 +153,16 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
       "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
 }
 
+// --journal and --resume (runners/journal.h).
+void AddJournalOptions(CLI::App* command, StreamOptions* o) {
+  command->add_option("--journal", o->journal,
+                      "usb, serial: record in this file which commands the device has executed, "
+                      "for --resume (docs/protocol.md, job journal)");
+  command->add_option("--resume", o->resume,
+                      "usb, serial: continue the job this journal records, with the same "
+                      "arguments, from the first command not executed (nothing drawn twice)");
+}
+
 }  // namespace
 
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
@@ -231,12 +241,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                     "run the job through the simulated plotter with these limits and report "
                     "machine time, pen-down and pen-up distance, pen lifts and the page extent; "
                     "nothing is sent to --device");
-  command->add_option("--journal", o->journal,
-                      "usb, serial: record in this file which commands the device has executed, "
-                      "for --resume (docs/protocol.md, job journal)");
-  command->add_option("--resume", o->resume,
-                      "usb, serial: continue the job this journal records, with the same "
-                      "arguments, from the first command not executed (nothing drawn twice)");
+  AddJournalOptions(command, o);
   command->add_flag("--no-pause", o->no_pause,
                     "between layers, say that the pen is to be changed but do not wait for Enter");
 }

@@ -92,7 +92,9 @@ std::map<std::string, Field> ReadFields(const std::string& path) {
                        "', not '" + kMagic + " " + kVersion + "')");
     }
     if (!fields.emplace(key, Field{value, line}).second) {
-      throw InputError(path + ":" + std::to_string(line) + ": " + key + ": given twice");
+      std::string message = path;
+      message += ":" + std::to_string(line) + ": " + key + ": given twice";
+      throw InputError(message);
     }
   }
   if (fields.empty()) throw InputError(path + ": empty: not an fdsurf journal");
@@ -194,7 +196,7 @@ StreamJob ResumedJob(const StreamJob& job, std::size_t executed, std::size_t* pr
                            " ended");
   if (pen_down) {
     resumed.commands.push_back(PenCommand(true));
-    resumed.labels.push_back("resume: pen down");
+    resumed.labels.emplace_back("resume: pen down");
   }
   *prefix = resumed.commands.size();
   for (std::size_t k = executed; k < job.commands.size(); ++k) {
