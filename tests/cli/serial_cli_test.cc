@@ -10,6 +10,7 @@
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/wait.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -206,6 +208,24 @@ constexpr int kLayeredCommands = 10;
 
 class SerialPause : public SerialCli {
  protected:
+  // fdsurf started with `args` on a fresh terminal (the fixture device is
+  // started first with `device_options`).
+  struct TerminalRun {
+    Terminal terminal;
+    Clock::time_point start = Clock::now();
+    pid_t pid = -1;
+  };
+  std::unique_ptr<TerminalRun> SpawnOnTerminal(const std::string& device_options,
+                                               const std::string& args) {
+    StartDevice(device_options);
+    auto run = std::make_unique<TerminalRun>();
+    EXPECT_GE(run->terminal.slave, 0);
+    if (run->terminal.slave < 0) return nullptr;
+    run->start = Clock::now();
+    run->pid = Spawn(args, run->terminal.slave);
+    return run;
+  }
+
   std::string LayeredStream(const std::string& extra = "") {
     const fs::path path = dir_ / "layers.gcode";
     std::ofstream(path) << kTwoLayers;
@@ -225,11 +245,8 @@ TEST_F(SerialPause, WaitsForEnterWithNothingOfLayer2Executed) {
   auto clean = StopDevice();
   ASSERT_EQ(clean["executed"], std::to_string(kLayeredCommands));
 
-  StartDevice("--speedup 20");
-  const Terminal terminal;
-  ASSERT_GE(terminal.slave, 0);
-  const auto start = Clock::now();
-  const pid_t pid = Spawn(LayeredStream(), terminal.slave);
+  const auto run = SpawnOnTerminal("--speedup 20", LayeredStream());
+  ASSERT_TRUE(run);
   ASSERT_TRUE(WaitForStderr(prompt_)) << Slurp(dir_ / "stderr");
   auto paused = Snapshot();
   EXPECT_EQ(paused["executed"], std::to_string(kBeforeLayer2));
@@ -240,8 +257,8 @@ TEST_F(SerialPause, WaitsForEnterWithNothingOfLayer2Executed) {
   EXPECT_EQ(later["executed"], std::to_string(kBeforeLayer2));
   EXPECT_EQ(later["digest"], paused["digest"]);
   EXPECT_EQ(Slurp(dir_ / "stderr").find("going on"), std::string::npos);
-  terminal.Type("\n");
-  const Result r = Finish(pid, start);
+  run->terminal.Type("\n");
+  const Result r = Finish(run->pid, run->start);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find(prompt_ + "fdsurf: layer 2/2 'T2': going on\n"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("3 curves in 2 layers drawn by serial " + link_), std::string::npos)
@@ -268,14 +285,11 @@ TEST_F(SerialPause, GoesOnWithoutWaitingWhenStdinIsNotATerminal) {
 }
 
 TEST_F(SerialPause, CtrlCDuringThePauseStopsAndExits130) {
-  StartDevice("--speedup 20");
-  const Terminal terminal;
-  ASSERT_GE(terminal.slave, 0);
-  const auto start = Clock::now();
-  const pid_t pid = Spawn(LayeredStream(), terminal.slave);
+  const auto run = SpawnOnTerminal("--speedup 20", LayeredStream());
+  ASSERT_TRUE(run);
   ASSERT_TRUE(WaitForStderr(prompt_)) << Slurp(dir_ / "stderr");
-  kill(pid, SIGINT);
-  const Result r = Finish(pid, start, 20);
+  kill(run->pid, SIGINT);
+  const Result r = Finish(run->pid, run->start, 20);
   EXPECT_EQ(r.exit_code, 130) << r.err;
   EXPECT_NE(r.err.find("fdsurf: stopped: serial " + link_ + " is at rest (idle, pen up) after " +
                        std::to_string(kBeforeLayer2) + " of " + std::to_string(kLayeredCommands) +
@@ -286,6 +300,130 @@ TEST_F(SerialPause, CtrlCDuringThePauseStopsAndExits130) {
   EXPECT_EQ(report["executed"], std::to_string(kBeforeLayer2));
   EXPECT_EQ(report["stops"], "1");
   EXPECT_EQ(report["pen_down"], "0");
+}
+
+// Space pauses: the device comes to rest with the pen up and holds (state
+// kPaused, nothing moves); space again resumes, and the job ends with the
+// same steps in the same order as a run without a pause. The terminal is
+// back in canonical mode with echo afterwards.
+TEST_F(SerialPause, SpacePausesAndResumesWithNoStepLostOrRepeated) {
+  StartDevice("--speedup 20");
+  ASSERT_EQ(Stream().exit_code, 0);
+  auto clean = StopDevice();
+  ASSERT_EQ(clean["executed"], "5");
+
+  const auto run = SpawnOnTerminal("--speedup 2",
+                                   "stream " + kJob + " --device 'serial:" + link_ + "'");  // ~10 s
+  ASSERT_TRUE(run);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  run->terminal.Type(" ");
+  ASSERT_TRUE(WaitForStderr("fdsurf: paused: space to resume\n")) << Slurp(dir_ / "stderr");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // decelerated, pen lifted
+  auto paused = Snapshot();
+  EXPECT_EQ(paused["state"], "4");  // kPaused
+  EXPECT_EQ(paused["pen_down"], "0");
+  EXPECT_EQ(paused["pauses"], "1");
+  EXPECT_NE(paused["executed"], "5");
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  auto later = Snapshot();
+  EXPECT_EQ(later["step_digest"], paused["step_digest"]);  // holding
+  EXPECT_EQ(later["state"], "4");
+  run->terminal.Type("p");
+  const Result r = Finish(run->pid, run->start);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("fdsurf: paused: space to resume\nfdsurf: resumed\n"), std::string::npos)
+      << r.err;
+  termios settings{};
+  ASSERT_EQ(tcgetattr(run->terminal.slave, &settings), 0);
+  EXPECT_NE(settings.c_lflag & ICANON, 0u);
+  EXPECT_NE(settings.c_lflag & ECHO, 0u);
+  auto report = StopDevice();
+  EXPECT_EQ(report["executed"], "5");
+  EXPECT_EQ(report["resumes"], "1");
+  EXPECT_EQ(report["step_digest"], clean["step_digest"]);
+  EXPECT_EQ(report["pen_down"], "0");
+}
+
+// The second Ctrl-C, while the first one's STOP is still decelerating the
+// device, sends HALT: it stops at once with the pen up and the drivers off,
+// the tool says so and exits 130.
+TEST_F(SerialCli, ASecondCtrlCHaltsTheDeviceAndExits130) {
+  StartDevice("--speedup 1");
+  const auto start = Clock::now();
+  // A slow deceleration (5 mm/s² from 20 mm/s: 4 s) leaves time for the second.
+  const pid_t pid =
+      Spawn("stream " + kJob + " --device 'serial:" + link_ + "' --speed 20 --accel 5");
+  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  kill(pid, SIGINT);
+  ASSERT_TRUE(WaitForStderr("fdsurf: interrupted: stopping the device")) << Slurp(dir_ / "stderr");
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  kill(pid, SIGINT);
+  const Result r = Finish(pid, start, 20);
+  EXPECT_EQ(r.exit_code, 130) << r.err;
+  EXPECT_NE(r.err.find("fdsurf: halted: serial " + link_ +
+                       " stopped at once with the pen lifted and the motors disabled"),
+            std::string::npos)
+      << r.err;
+  auto report = StopDevice();
+  EXPECT_EQ(report["halts"], "1");
+  EXPECT_EQ(report["pen_down"], "0");
+  EXPECT_EQ(report["enabled"], "0");
+  EXPECT_EQ(report["idle"], "1");
+}
+
+// A zigzag of 30 pen-down lines: CONFIG, travel, pen down, 30 MOVEs, pen
+// up: more commands than the device queues (8).
+std::string Zigzag() {
+  std::string g = "G21 G90\nG0 X0 Y0\nM3\n";
+  for (int i = 1; i <= 30; ++i) {
+    g += "G1 X" + std::to_string(i * 2) + " Y" + std::to_string(i % 2 == 0 ? 0 : 10) + "\n";
+  }
+  return g + "M5\n";
+}
+
+// The tool killed mid-job (SIGKILL: no STOP, no last journal write) and
+// `--resume` with the same arguments: the device finishes what it had
+// accepted, the rest follows from the first command it had not executed,
+// and the union of the two runs steps exactly the steps of one
+// uninterrupted run, in order: nothing drawn twice, nothing left out.
+TEST_F(SerialCli, AJobKilledMidwayIsResumedFromItsJournalDrawingNothingTwice) {
+  const fs::path gcode = dir_ / "zigzag.gcode";
+  std::ofstream(gcode) << Zigzag();
+  const std::string job = "stream '" + gcode.string() +
+                          "' --view top --fit none --device 'serial:" + link_ + "' --speed 40";
+  StartDevice("--speedup 20");
+  ASSERT_EQ(Run(job).exit_code, 0);
+  auto clean = StopDevice();
+  ASSERT_EQ(clean["executed"], "34");
+
+  StartDevice("--speedup 1");
+  const std::string journal = (dir_ / "job.journal").string();
+  const pid_t pid = Spawn(job + " --journal '" + journal + "'");
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  const std::string written = Slurp(journal);
+  ASSERT_NE(written.find("fdsurf-journal 1\n"), std::string::npos) << written;
+  ASSERT_EQ(written.find("executed 34\n"), std::string::npos) << "the job ended before the kill";
+  auto killed = Snapshot();
+  EXPECT_NE(killed["idle"], "1");  // the device goes on with what it had accepted
+
+  const Result r = Run(job + " --resume '" + journal + "'", 60);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("commands executed (as the device reports it)"), std::string::npos) << r.err;
+  EXPECT_NE(Slurp(journal).find("executed 34\n"), std::string::npos) << Slurp(journal);
+  auto report = StopDevice();
+  EXPECT_EQ(report["step_digest"], clean["step_digest"]);
+  EXPECT_EQ(report["steps_x"], clean["steps_x"]);
+  EXPECT_EQ(report["pen_down"], "0");
+
+  // Another job under the same journal is refused before anything is sent.
+  StartDevice("--speedup 20");
+  const Result other = Run(job + " --pen-delay 50 --resume '" + journal + "'");
+  EXPECT_EQ(other.exit_code, 2) << other.err;
+  EXPECT_NE(other.err.find(journal + ": the journal is of another job"), std::string::npos)
+      << other.err;
+  EXPECT_EQ(StopDevice()["hellos"], "0");
 }
 
 TEST_F(SerialCli, StreamsAJobThatTheDeviceExecutesOnce) {
@@ -423,7 +561,7 @@ TEST_F(SerialCli, PortsProbeShowsWhatAnswered) {
   ASSERT_NE(line, std::string::npos) << r.out;
   const std::string row = r.out.substr(line, r.out.find('\n', line) - line);
   EXPECT_NE(row.find(" pty "), std::string::npos) << row;
-  EXPECT_NE(row.find("fdsurf protocol 2, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
+  EXPECT_NE(row.find("fdsurf protocol 3, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
       << row;
   // The machine's own ports (if any are listed) are shown, not opened.
   std::istringstream rows(r.out);

@@ -34,6 +34,9 @@ struct FakeSink {
   uint32_t executed = 0;
   int resets = 0;
   int stops = 0;
+  int pauses = 0;
+  int resumes = 0;
+  int halts = 0;
   int accept_calls_without_credit = 0;
   // Refuse the command accepted as number refuse_at (0-based), if set.
   int64_t refuse_at = -1;
@@ -66,6 +69,12 @@ struct FakeSink {
   }
   void Stop() {
     ++stops;
+    queue.clear();
+  }
+  void Pause() { ++pauses; }
+  void Resume() { ++resumes; }
+  void Halt() {
+    ++halts;
     queue.clear();
   }
   void Reset() {
@@ -733,7 +742,8 @@ TEST(HostLink, VersionMismatchFails) {
                            reply.size()));
   link.OnBytes(reply.data(), reply.size(), 10);
   ASSERT_TRUE(link.Failed());
-  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host 2");
+  EXPECT_EQ(link.error(),
+            "protocol version mismatch: device speaks 1, host " + std::to_string(kProtocolVersion));
 }
 
 TEST(HostLink, StopIsSentUntilAcknowledged) {
@@ -1095,6 +1105,79 @@ TEST(HostLink, GivingUpSendsStopFirst) {
   }
   EXPECT_GE(h.sink.stops, 1) << "the device was not told to stop";
   EXPECT_TRUE(h.sink.queue.empty());
+}
+
+// PAUSE, RESUME and HALT are repeated until acknowledged, through a line
+// that loses a fifth of everything; commands keep flowing meanwhile.
+TEST(HostLink, PauseResumeAndHaltAreSentUntilAcknowledged) {
+  Harness h(TestOptions(), FaultRates::All(0.2), 15);
+  h.drain_every = 50;
+  EnqueueJob(&h.host, 200);
+  while (h.sink.accepted.size() < 20) {
+    h.Step();
+  }
+  h.host.RequestPause();
+  EXPECT_EQ(h.host.NextPollUs(h.now), h.now);
+  for (int k = 0; k < 100000 && !h.host.PauseAcknowledged() && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  ASSERT_TRUE(h.host.PauseAcknowledged()) << h.host.error();
+  EXPECT_GE(h.sink.pauses, 1);
+  EXPECT_FALSE(h.host.ResumeAcknowledged());
+  h.host.RequestResume();
+  EXPECT_FALSE(h.host.PauseAcknowledged());
+  for (int k = 0; k < 100000 && !h.host.ResumeAcknowledged() && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  ASSERT_TRUE(h.host.ResumeAcknowledged()) << h.host.error();
+  EXPECT_GE(h.sink.resumes, 1);
+  for (int k = 0; k < 20000; ++k) {
+    h.Step();
+  }
+  EXPECT_GT(h.sink.accepted.size(), 20u);  // the job went on
+  // HALT after a STOP already acknowledged: sent anyway.
+  h.host.RequestStop();
+  for (int k = 0; k < 100000 && !h.host.StopAcknowledged() && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  ASSERT_TRUE(h.host.StopAcknowledged());
+  h.host.RequestHalt();
+  EXPECT_FALSE(h.host.HaltAcknowledged());
+  for (int k = 0; k < 100000 && !h.host.HaltAcknowledged() && !h.host.Failed(); ++k) {
+    h.Step();
+  }
+  EXPECT_TRUE(h.host.HaltAcknowledged()) << h.host.error();
+  EXPECT_GE(h.sink.halts, 1);
+  EXPECT_EQ(h.host.NextPollUs(h.now), UINT64_MAX);
+}
+
+// Against the firmware: a paused device reports kPaused, the host does not
+// call the job finished, and after RESUME the job ends with every command
+// executed once.
+TEST(Sessions, APausedDeviceHoldsUntilResumed) {
+  RealDevice d;
+  HostLink host(TestOptions());
+  ASSERT_TRUE(host.Enqueue(Config(8000), "config").ok());
+  ASSERT_TRUE(host.Enqueue(Move(20000, 1000), "move").ok());
+  ASSERT_TRUE(host.Enqueue(Move(100, 100), "back").ok());
+  while (d.device.motion().speed() < 20000 && !host.Failed()) {
+    d.Exchange(&host);
+  }
+  host.RequestPause();
+  for (int k = 0; k < 400000 && !host.Failed(); ++k) {  // 10 s
+    d.Exchange(&host);
+  }
+  ASSERT_TRUE(host.PauseAcknowledged()) << host.error();
+  ASSERT_FALSE(host.Failed()) << host.error();  // status answers keep the link alive
+  EXPECT_FALSE(host.Finished());
+  ASSERT_TRUE(host.status().has_value());
+  EXPECT_EQ(host.status()->state, DeviceState::kPaused);
+  EXPECT_LT(d.device.motion().position()[0], 20000);
+  host.RequestResume();
+  d.Run(&host, d.now + 60'000'000);
+  ASSERT_TRUE(host.Finished()) << (host.Failed() ? host.error() : "not finished");
+  EXPECT_EQ(d.device.executed(), 3u);
+  EXPECT_EQ(d.device.motion().position()[0], 100);
 }
 
 TEST(FaultLink, IsDeterministicAndCountsWhatItDid) {

@@ -69,21 +69,30 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
   RecordingOutputs() : StepDirOutputs(2) {}
   uint64_t steps[3] = {0, 0, 0};
   uint64_t digest = 1469598103934665603ull;
+  /// The same over the steps only (a pause adds a pen lift and lowering).
+  uint64_t step_digest = 1469598103934665603ull;
   bool pen_down = false;
+  bool enabled = false;
 
  private:
   void Fold(uint8_t byte) {
     digest ^= byte;
     digest *= 1099511628211ull;
   }
-  fdsurf::hal::IoStatus DoSetEnabled(bool) override { return fdsurf::hal::IoStatus::kOk; }
+  fdsurf::hal::IoStatus DoSetEnabled(bool on) override {
+    enabled = on;
+    return fdsurf::hal::IoStatus::kOk;
+  }
   fdsurf::hal::IoStatus DoSetDirections(uint8_t negative_mask) override {
     negative_ = negative_mask;
     return fdsurf::hal::IoStatus::kOk;
   }
   fdsurf::hal::IoStatus DoStep(uint8_t axis_mask) override {
     for (int a = 0; a < 3; ++a) steps[a] += (axis_mask >> a) & 1u;
-    Fold(static_cast<uint8_t>(axis_mask | (negative_ & axis_mask) << 4));
+    const auto byte = static_cast<uint8_t>(axis_mask | (negative_ & axis_mask) << 4);
+    Fold(byte);
+    step_digest ^= byte;
+    step_digest *= 1099511628211ull;
     return fdsurf::hal::IoStatus::kOk;
   }
   fdsurf::hal::IoStatus DoSetPen(bool down) override {
@@ -235,6 +244,12 @@ struct Run {
                  stats.stops, stats.hellos, stats.duplicates, stats.commands_accepted,
                  outputs.pen_down ? 1 : 0, device.Idle() ? 1 : 0);
     std::fprintf(f, "bytes_in %ld\n", bytes_in);
+    fdsurf::protocol::StatusReport status{};
+    device.FillStatus(&status);
+    std::fprintf(f, "pauses %u\nresumes %u\nhalts %u\nstep_digest %016llx\nenabled %d\nstate %d\n",
+                 stats.pauses, stats.resumes, stats.halts,
+                 static_cast<unsigned long long>(outputs.step_digest), outputs.enabled ? 1 : 0,
+                 static_cast<int>(status.state));
     std::fclose(f);
     std::rename(temporary.c_str(), o.report.c_str());
   }

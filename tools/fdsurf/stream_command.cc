@@ -12,6 +12,7 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/host/text.h"
+#include "runners/journal.h"
 #include "runners/machine_schedule.h"
 #include "runners/runner.h"
 #include "runners/serial_session.h"
@@ -115,7 +116,12 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
     if (o.dry_run) return RunDryRun(o, job);
     const DeviceKind kind = DeviceKindOf(o.device);
     if (kind == DeviceKind::kSim) return RunSimulated(o, set, job, drawing, o.units);
-    const StreamOptions real = WithSchedule(o, job);
+    StreamOptions real = WithSchedule(o, job);
+    if (!o.resume.empty()) {
+      auto state = std::make_shared<JournalState>(ReadJournal(o.resume));
+      CheckJournalMatches(o.resume, *state, job);
+      real.resume_state = std::move(state);
+    }
     switch (kind) {
       case DeviceKind::kUsb:
         return RunUsb(real, job);
@@ -145,6 +151,16 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   command->add_option(
       "--accel", o->accel_limit,
       "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+}
+
+// --journal and --resume (runners/journal.h).
+void AddJournalOptions(CLI::App* command, StreamOptions* o) {
+  command->add_option("--journal", o->journal,
+                      "usb, serial: record in this file which commands the device has executed, "
+                      "for --resume (docs/protocol.md, job journal)");
+  command->add_option("--resume", o->resume,
+                      "usb, serial: continue the job this journal records, with the same "
+                      "arguments, from the first command not executed (nothing drawn twice)");
 }
 
 }  // namespace
@@ -225,6 +241,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                     "run the job through the simulated plotter with these limits and report "
                     "machine time, pen-down and pen-up distance, pen lifts and the page extent; "
                     "nothing is sent to --device");
+  AddJournalOptions(command, o);
   command->add_flag("--no-pause", o->no_pause,
                     "between layers, say that the pen is to be changed but do not wait for Enter");
 }
@@ -240,6 +257,13 @@ int RunStream(const StreamOptions& options) {
                      "gpio:CHIP:LINES");
   }
   const bool drawing_out = !o.svg.empty() || !o.png.empty() || !o.waveform.empty();
+  const DeviceKind device_kind = DeviceKindOf(o.device);
+  if ((!o.journal.empty() || !o.resume.empty()) &&
+      (o.dry_run || (device_kind != DeviceKind::kUsb && device_kind != DeviceKind::kSerial))) {
+    throw InputError(
+        "--journal and --resume are for --device usb and serial, whose device keeps its state "
+        "when the tool stops (not sim or gpio, nor --dry-run)");
+  }
   if (!sim && ((drawing_out && !o.dry_run) || o.faults > 0 || o.sim_cost != "none")) {
     throw InputError(
         "--svg, --png, --waveform, --faults and --sim-cost are for --device sim (--svg, --png "

@@ -17,6 +17,7 @@ class App;
 namespace fdsurf::host {
 
 struct MachineSchedule;  // runners/machine_schedule.h
+struct JournalState;     // runners/journal.h
 
 struct StreamOptions {
   std::string file;
@@ -77,6 +78,12 @@ struct StreamOptions {
   /// A real device's schedule in machine time for its progress line (set by
   /// RunStream when the progress line shows; nullptr otherwise).
   std::shared_ptr<const MachineSchedule> schedule;
+  /// --journal FILE: record which commands the device executed (usb,
+  /// serial). --resume FILE: continue the job that FILE journals; its state,
+  /// read and checked against the job by RunStream.
+  std::string journal;
+  std::string resume;
+  std::shared_ptr<const JournalState> resume_state;
 };
 
 /// Adds the options of `stream` to `command`.

@@ -60,6 +60,7 @@ void MotionLoop::Clear() {
   braking_ = 0;
   pen_wait_ = 0;
   stopping_ = false;
+  pausing_ = false;
 }
 
 void MotionLoop::set_position(const int32_t (&position)[3]) {
@@ -77,6 +78,8 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     --pen_wait_;
     return out;
   }
+  // Held at a pause: nothing is passed, not even a pen event at the head.
+  if (pausing_ && speed_ == 0) return out;
   // Entries that are not moves are passed at rest (pen events) or on the fly
   // (command boundaries).
   while (count_ > 0 && KindOf(At(0)) != EntryKind::kMove) {
@@ -103,10 +106,15 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     }
     return out;
   }
-  if (stopping_ && speed_ <= limits_.accel) {
-    // At rest (or one deceleration from it): the stop is complete.
+  const bool braking = stopping_ || pausing_;
+  if (braking && speed_ <= limits_.accel) {
+    // At rest (or one deceleration from it): the stop or pause is complete.
+    // A pause forgets the progress into the head move: the motor has not
+    // moved for it, and a restart from rest must cover the whole unit move
+    // (else its first step comes sooner than the acceleration allows).
     speed_ = 0;
     braking_ = 0;
+    if (pausing_) phase_ = 0;
     return out;
   }
   if (count_ == 0) {
@@ -119,18 +127,18 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
   const uint32_t a = limits_.accel;
   const uint64_t v = speed_;
   uint64_t advance = 0;
-  if (!stopping_ && v + a <= limits_.max_speed && (v + a) + braking_ + v <= available) {
+  if (!braking && v + a <= limits_.max_speed && (v + a) + braking_ + v <= available) {
     braking_ += v;  // B(n+1) = B(n) + n·a
     speed_ += a;
     advance = speed_;
-  } else if (!stopping_ && v + braking_ <= available && v <= limits_.max_speed) {
+  } else if (!braking && v + braking_ <= available && v <= limits_.max_speed) {
     advance = v;
   } else if (v >= a) {
     speed_ -= a;
     braking_ -= speed_;  // B(n−1) = B(n) − (n−1)·a
     advance = speed_;
   }
-  if (speed_ == 0 && !stopping_) {
+  if (speed_ == 0 && !braking) {
     // At rest with less than one acceleration step to go: cover it exactly.
     advance = available < a ? available : 0;
   }

@@ -365,6 +365,18 @@ size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity, uint32_t sessio
   return EncodeFrame(MessageType::kStop, token, nullptr, 0, out, capacity, session);
 }
 
+size_t EncodePause(uint16_t token, uint8_t* out, size_t capacity, uint32_t session) {
+  return EncodeFrame(MessageType::kPause, token, nullptr, 0, out, capacity, session);
+}
+
+size_t EncodeResume(uint16_t token, uint8_t* out, size_t capacity, uint32_t session) {
+  return EncodeFrame(MessageType::kResume, token, nullptr, 0, out, capacity, session);
+}
+
+size_t EncodeHalt(uint16_t token, uint8_t* out, size_t capacity, uint32_t session) {
+  return EncodeFrame(MessageType::kHalt, token, nullptr, 0, out, capacity, session);
+}
+
 size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity,
                         uint32_t session) {
   FrameEncoder encoder(out, capacity);
@@ -513,7 +525,7 @@ DecodeResult DecodeReply(const Frame& frame, Reply* out) {
     case MessageType::kStatusReport: {
       StatusReport& s = out->body.status;
       const uint8_t state = r.U8(kStatusFieldState);
-      r.Check(state <= static_cast<uint8_t>(DeviceState::kFault), kStatusFieldState);
+      r.Check(state <= static_cast<uint8_t>(DeviceState::kPaused), kStatusFieldState);
       s.state = static_cast<DeviceState>(state);
       const uint8_t error = r.U8(kStatusFieldError);
       r.Check(ErrorCodeValid(error), kStatusFieldError);

@@ -17,6 +17,9 @@ struct NullSink {
   FDSURF_NODISCARD uint8_t MaxAxes() const { return 2; }
   void FillStatus(StatusReport* /*report*/) const {}
   void Stop() {}
+  void Pause() {}
+  void Resume() {}
+  void Halt() {}
   void Reset() {}
 };
 

@@ -416,6 +416,30 @@ TEST(Codec, HelloAndEmptyBodies) {
   EXPECT_EQ(DecodeEmpty(BodyFrame(MessageType::kStop, Bytes{0})).code, ErrorCode::kBadLength);
 }
 
+TEST(Codec, PauseResumeAndHaltAreEmptyTokenFrames) {
+  using Encoder = size_t (*)(uint16_t, uint8_t*, size_t, uint32_t);
+  const struct {
+    Encoder encode;
+    MessageType type;
+  } cases[] = {{EncodePause, MessageType::kPause},
+               {EncodeResume, MessageType::kResume},
+               {EncodeHalt, MessageType::kHalt}};
+  for (const auto& c : cases) {
+    Bytes wire(kMaxEncodedFrameBytes, 0);
+    Bytes storage;
+    wire.resize(c.encode(0x1234, wire.data(), wire.size(), 0));
+    const Frame frame = Unwire(wire, &storage);
+    EXPECT_EQ(frame.type, static_cast<uint8_t>(c.type));
+    EXPECT_EQ(frame.seq, 0x1234);
+    EXPECT_EQ(frame.body_size, 0u);
+    EXPECT_TRUE(DecodeEmpty(frame).ok());
+    EXPECT_FALSE(IsSequenced(c.type));
+    const DecodeResult r = DecodeEmpty(BodyFrame(c.type, Bytes{0}));
+    EXPECT_EQ(r.code, ErrorCode::kBadLength);
+    EXPECT_EQ(r.field, 0);
+  }
+}
+
 Reply RoundTripReply(const Bytes& wire) {
   Bytes storage;
   Reply reply;
@@ -515,7 +539,9 @@ TEST(CodecValidation, Replies) {
   // STATUS_REPORT: state, error code and pen byte ranges.
   Bytes status(28, 0);
   EXPECT_TRUE(decode(MessageType::kStatusReport, status).ok());
-  status[0] = 4;
+  status[0] = 4;  // kPaused (protocol version 3)
+  EXPECT_TRUE(decode(MessageType::kStatusReport, status).ok());
+  status[0] = 5;
   EXPECT_EQ(decode(MessageType::kStatusReport, status).field, kStatusFieldState);
   status[0] = 0;
   status[1] = kLastErrorCode + 1;

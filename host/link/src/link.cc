@@ -25,6 +25,12 @@ const char* TypeName(MessageType type) {
       return "status query";
     case MessageType::kStop:
       return "stop";
+    case MessageType::kPause:
+      return "pause";
+    case MessageType::kResume:
+      return "resume";
+    case MessageType::kHalt:
+      return "halt";
     case MessageType::kConfig:
       return "config";
     case MessageType::kPatch:
@@ -193,6 +199,9 @@ void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
       if (stop_sent_ && reply.seq == stop_token_) {
         stop_acked_ = true;
       }
+      if (control_sent_ && reply.seq == control_token_) {
+        control_acked_ = true;
+      }
       return;
     }
     case MessageType::kNak: {
@@ -336,7 +345,9 @@ void HostLink::HandleError(const protocol::Reply& reply, uint64_t now_us) {
   } else if (status_outstanding_ && e.seq == status_token_) {
     what = "status query";
   } else if (stop_sent_ && e.seq == stop_token_) {
-    what = "stop";
+    what = halt_ ? "halt" : "stop";
+  } else if (control_sent_ && e.seq == control_token_) {
+    what = TypeName(control_type_);
   } else {
     what = "an unknown frame (seq " + std::to_string(e.seq) + ")";
   }
@@ -383,7 +394,9 @@ bool HostLink::Timeout(uint64_t now_us, std::vector<uint8_t>* out) {
   } else if (status_outstanding_) {
     waiting = "a status report";
   } else if (stop_requested_) {
-    waiting = "the acknowledgement of stop";
+    waiting = halt_ ? "the acknowledgement of halt" : "the acknowledgement of stop";
+  } else if (control_requested_ && !control_acked_) {
+    waiting = std::string("the acknowledgement of ") + TypeName(control_type_);
   }
   // Tell the device to stop before giving up, so that it does not go on
   // with the commands it queued (twice: the line is evidently bad).
@@ -401,7 +414,35 @@ bool HostLink::Timeout(uint64_t now_us, std::vector<uint8_t>* out) {
 void HostLink::SendStop(std::vector<uint8_t>* out) {
   stop_token_ = next_token_++;
   std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
-  Send(frame.data(), protocol::EncodeStop(stop_token_, frame.data(), frame.size(), session_), out);
+  Send(frame.data(),
+       halt_ ? protocol::EncodeHalt(stop_token_, frame.data(), frame.size(), session_)
+             : protocol::EncodeStop(stop_token_, frame.data(), frame.size(), session_),
+       out);
+}
+
+bool HostLink::PollControl(uint64_t now_us, std::vector<uint8_t>* out) {
+  if (!control_requested_ || control_acked_) {
+    return true;
+  }
+  if (control_sent_ && now_us - control_sent_us_ < Rto()) {
+    return true;
+  }
+  if (control_sent_ && Timeout(now_us, out)) {
+    return false;
+  }
+  // One token per request: an ACK of any of its transmissions counts.
+  if (!control_sent_) {
+    control_token_ = next_token_++;
+  }
+  std::array<uint8_t, protocol::kMaxEncodedFrameBytes> frame{};
+  const size_t size =
+      control_type_ == MessageType::kPause
+          ? protocol::EncodePause(control_token_, frame.data(), frame.size(), session_)
+          : protocol::EncodeResume(control_token_, frame.data(), frame.size(), session_);
+  Send(frame.data(), size, out);
+  control_sent_ = true;
+  control_sent_us_ = now_us;
+  return true;
 }
 
 void HostLink::Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out) {
@@ -478,6 +519,9 @@ void HostLink::Poll(uint64_t now_us, std::vector<uint8_t>* out) {
     }
     return;  // nothing else after a stop
   }
+  if (!PollControl(now_us, out)) {
+    return;
+  }
   // Retransmit timeout: go back to the oldest unacknowledged frame.
   if (next_send_ > 0 && now_us - RetransmitTimerStart() >= rto) {
     if (Timeout(now_us, out)) {
@@ -531,6 +575,16 @@ uint64_t HostLink::NextPollUs(uint64_t now_us) const {
     }
     return stop_sent_ ? std::max(now_us, stop_sent_us_ + rto) : now_us;
   }
+  // A PAUSE or RESUME waiting for its ACK is due at its retransmission.
+  const uint64_t control_due = !control_requested_ || control_acked_ ? kNever
+                               : control_sent_ ? std::max(now_us, control_sent_us_ + rto)
+                                               : now_us;
+  return std::min(control_due, NextCommandPollUs(now_us));
+}
+
+uint64_t HostLink::NextCommandPollUs(uint64_t now_us) const {
+  constexpr uint64_t kNever = std::numeric_limits<uint64_t>::max();
+  const uint64_t rto = Rto();
   if (next_send_ < SendLimit()) {
     return now_us;
   }
@@ -556,6 +610,7 @@ void HostLink::Resume() {
   hello_sent_ = false;
   status_outstanding_ = false;
   stop_sent_ = false;
+  control_sent_ = false;  // an unacknowledged PAUSE or RESUME goes again
   retries_ = 0;
   rto_us_ = options_.retransmit_timeout_us;
   progress_known_ = false;  // a fresh give-up clock from the next Poll
@@ -564,6 +619,27 @@ void HostLink::Resume() {
 }
 
 void HostLink::RequestStop() { stop_requested_ = true; }
+
+void HostLink::RequestPause() {
+  control_requested_ = true;
+  control_type_ = MessageType::kPause;
+  control_sent_ = false;
+  control_acked_ = false;
+}
+
+void HostLink::RequestResume() {
+  control_requested_ = true;
+  control_type_ = MessageType::kResume;
+  control_sent_ = false;
+  control_acked_ = false;
+}
+
+void HostLink::RequestHalt() {
+  stop_requested_ = true;
+  halt_ = true;
+  stop_sent_ = false;
+  stop_acked_ = false;
+}
 
 bool HostLink::Finished() const {
   if (!AllAcknowledged() || !status_ || status_->next_seq != base_seq_) {

@@ -47,6 +47,26 @@ void Tick(GpioRig& rig, Device& device, std::uint64_t total_commands, KeepGoing 
   }
 }
 
+// After a second Ctrl-C: HALT through the link (the device drops everything
+// at once), a few ticks for it to take effect, and then the pen lifted and
+// the drivers disabled directly on the lines, whatever the device did; 130.
+template <class Device>
+int HaltNow(const StreamOptions& o, GpioRig& rig, Device& device) {
+  if (!o.quiet) std::fprintf(stderr, "\nfdsurf: interrupted again: halting\n");
+  rig.link.RequestHalt();
+  const std::uint64_t deadline = rig.clock.NowMicros() + 200'000;
+  Tick(rig, device, 0,
+       [&] { return !rig.link.HaltAcknowledged() && rig.clock.NowMicros() < deadline; });
+  const bool lifted = rig.outputs.SetPen(false) == hal::IoStatus::kOk;
+  const bool disabled = rig.outputs.SetEnabled(false) == hal::IoStatus::kOk;
+  std::fprintf(stderr,
+               "fdsurf: halted: gpio %s stopped at once, pen %s, drivers %s (the position may be "
+               "lost: home before the next job)\n",
+               o.device.c_str(), lifted ? "lifted" : "NOT lifted",
+               disabled ? "disabled" : "NOT disabled");
+  return 130;
+}
+
 // After Ctrl-C: STOP through the link (the device decelerates along its path
 // and lifts the pen), ticks until it rests (10 s at most), what was done; 130.
 template <class Device>
@@ -56,8 +76,10 @@ int StopAtRest(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Devic
   rig.link.RequestStop();
   const std::uint64_t deadline = rig.clock.NowMicros() + 10'000'000;
   Tick(rig, device, job.commands.size(), [&] {
-    return !(rig.link.StopAcknowledged() && device.Idle()) && rig.clock.NowMicros() < deadline;
+    return !(rig.link.StopAcknowledged() && device.Idle()) && rig.clock.NowMicros() < deadline &&
+           !InterruptGuard::Again();
   });
+  if (InterruptGuard::Again()) return HaltNow(o, rig, device);
   const bool pen_down = device.motion().pen_down();
   std::fprintf(stderr,
                "fdsurf: stopped: gpio %s is %s (pen %s) after %u of %zu commands executed\n",
@@ -78,8 +100,13 @@ int RunLayers(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device
     const std::size_t to = NextLayerBoundary(job, from);
     rig.progress.SetLayer(LayerLabel(job, from));
     Enqueue(job, &link, from, to);
-    Tick(rig, device, job.commands.size(),
-         [&] { return !link.Finished() && !link.Failed() && !InterruptGuard::Interrupted(); });
+    {
+      PauseToggle pause(true, o.quiet, &rig.progress);
+      Tick(rig, device, job.commands.size(), [&] {
+        pause.Poll(&link);
+        return !link.Finished() && !link.Failed() && !InterruptGuard::Interrupted();
+      });
+    }
     if (InterruptGuard::Interrupted()) return StopAtRest(o, job, rig, device);
     if (link.Failed() || to == job.commands.size()) break;
     if (device.motion().pen_down()) {

@@ -3,6 +3,7 @@
 
 #include <poll.h>
 #include <signal.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -22,11 +23,16 @@ namespace {
 volatile sig_atomic_t g_interrupts = 0;
 struct sigaction g_previous_int {};
 struct sigaction g_previous_term {};
+// The terminal's settings while PauseKeys has changed them, for the exit on
+// a third signal (tcsetattr is async-signal-safe).
+termios g_saved_terminal{};
+volatile sig_atomic_t g_terminal_saved = 0;
 
 void OnInterrupt(int) {
   g_interrupts = g_interrupts + 1;
-  if (g_interrupts >= 2) {
-    static const char kMessage[] = "\nfdsurf: interrupted again: exiting at once\n";
+  if (g_interrupts >= 3) {
+    if (g_terminal_saved != 0) tcsetattr(STDIN_FILENO, TCSANOW, &g_saved_terminal);
+    static const char kMessage[] = "\nfdsurf: interrupted a third time: exiting at once\n";
     (void)!write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
     _exit(130);
   }
@@ -77,6 +83,65 @@ InterruptGuard::~InterruptGuard() {
 }
 
 bool InterruptGuard::Interrupted() { return g_interrupts != 0; }
+
+bool InterruptGuard::Again() { return g_interrupts >= 2; }
+
+PauseKeys::PauseKeys(bool enabled) {
+  if (!enabled || ::isatty(STDIN_FILENO) == 0 || g_terminal_saved != 0) return;
+  termios settings{};
+  if (tcgetattr(STDIN_FILENO, &settings) != 0) return;
+  g_saved_terminal = settings;
+  settings.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);  // ISIG stays: Ctrl-C signals
+  settings.c_cc[VMIN] = 0;
+  settings.c_cc[VTIME] = 0;
+  g_terminal_saved = 1;
+  if (tcsetattr(STDIN_FILENO, TCSANOW, &settings) != 0) {
+    g_terminal_saved = 0;
+    return;
+  }
+  active_ = true;
+}
+
+PauseKeys::~PauseKeys() {
+  if (!active_) return;
+  tcsetattr(STDIN_FILENO, TCSANOW, &g_saved_terminal);
+  g_terminal_saved = 0;
+}
+
+bool PauseKeys::Pressed() {
+  if (!active_) return false;
+  bool pressed = false;
+  for (;;) {
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&in, 1, 0) <= 0 || (in.revents & POLLIN) == 0) return pressed;
+    char keys[64];
+    const ssize_t got = ::read(STDIN_FILENO, keys, sizeof keys);
+    if (got <= 0) return pressed;
+    for (ssize_t i = 0; i < got; ++i) {
+      pressed = pressed || keys[i] == ' ' || keys[i] == 'p' || keys[i] == 'P';
+    }
+  }
+}
+
+PauseToggle::PauseToggle(bool enabled, bool quiet, ProgressLine* progress)
+    : keys_(enabled), quiet_(quiet), progress_(progress) {
+  progress_->SetPauseState(keys_.active(), false);
+}
+
+void PauseToggle::Poll(HostLink* link) {
+  if (!keys_.Pressed()) return;
+  paused_ = !paused_;
+  if (paused_) {
+    link->RequestPause();
+  } else {
+    link->RequestResume();
+  }
+  progress_->SetPauseState(true, paused_);
+  if (!quiet_) {
+    progress_->Finish();
+    std::fprintf(stderr, paused_ ? "fdsurf: paused: space to resume\n" : "fdsurf: resumed\n");
+  }
+}
 
 // Status queries four times a second: enough for the progress line and for
 // noticing the end, few enough to leave the link to the commands.
@@ -169,10 +234,13 @@ void ProgressLine::Show(std::uint64_t executed, std::uint64_t total, std::uint64
                   wall > 0 ? static_cast<double>(executed) / wall : 0.0);
   }
   const std::string layer = layer_.empty() ? std::string() : layer_ + " ";
+  const char* hint = !pause_keys_ ? ""
+                     : paused_    ? "  paused — space to resume"
+                                  : "  [space: pause]";
   std::fprintf(
-      stderr, "\rfdsurf: %s[%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s   ",
+      stderr, "\rfdsurf: %s[%s] %3d%%  %llu/%llu commands executed, %llu frames sent, %s%s   ",
       layer.c_str(), bar.c_str(), percent, static_cast<unsigned long long>(executed),
-      static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate);
+      static_cast<unsigned long long>(total), static_cast<unsigned long long>(frames), rate, hint);
   shown_ = true;
 }
 

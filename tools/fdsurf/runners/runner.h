@@ -60,9 +60,11 @@ std::string LayerLabel(const StreamJob& job, std::size_t command);
 /// when neither).
 std::string JobContents(const StreamJob& job);
 
-/// SIGINT and SIGTERM counted while it lives (the first is the runner's to
-/// act on; the second exits the process with 130); the previous handlers
-/// come back on destruction. Without one, Ctrl-C ends the process as usual.
+/// SIGINT and SIGTERM counted while it lives: the first is the runner's to
+/// act on (STOP), the second too (HALT, Again()); a third exits the process
+/// at once with 130, the terminal restored (PauseKeys). The previous
+/// handlers come back on destruction. Without one, Ctrl-C ends the process
+/// as usual.
 class InterruptGuard {
  public:
   InterruptGuard();
@@ -71,6 +73,47 @@ class InterruptGuard {
   InterruptGuard& operator=(const InterruptGuard&) = delete;
   /// A signal arrived since construction.
   static bool Interrupted();
+  /// A second one arrived: the emergency stop (HALT) is wanted.
+  static bool Again();
+};
+
+/// The pause key on a terminal: while it lives and stdin is a terminal (and
+/// `enabled`), stdin is in non-canonical mode without echo (Ctrl-C still
+/// signals), so that one key press is read without Enter; the terminal's
+/// settings come back on destruction, and on a third Ctrl-C's exit.
+class PauseKeys {
+ public:
+  explicit PauseKeys(bool enabled);
+  ~PauseKeys();
+  PauseKeys(const PauseKeys&) = delete;
+  PauseKeys& operator=(const PauseKeys&) = delete;
+  /// Keys are read (stdin is a terminal and the mode was set).
+  FDSURF_NODISCARD bool active() const { return active_; }
+  /// Reads what was typed without waiting: true if it held space or 'p'.
+  bool Pressed();
+
+ private:
+  bool active_ = false;
+};
+
+class ProgressLine;
+
+/// Pause and resume by key for a runner whose device is behind `link`: each
+/// press of space or 'p' sends PAUSE, the next RESUME (HostLink retransmits
+/// them until acknowledged); says so on stderr (unless quiet) and in the
+/// progress line.
+class PauseToggle {
+ public:
+  PauseToggle(bool enabled, bool quiet, ProgressLine* progress);
+  /// Reads the keys; on a press asks `link` to pause or to resume.
+  void Poll(HostLink* link);
+  FDSURF_NODISCARD bool paused() const { return paused_; }
+
+ private:
+  PauseKeys keys_;
+  bool quiet_;
+  ProgressLine* progress_;
+  bool paused_ = false;
 };
 
 /// At a layer boundary (`command` = a LayerStart's command), once the device
@@ -108,6 +151,12 @@ class ProgressLine {
   void SetLayer(std::string label) { layer_ = std::move(label); }
   /// The job's schedule (ScheduleJob), or nullptr for none; not owned.
   void SetSchedule(const MachineSchedule* schedule) { schedule_ = schedule; }
+  /// The pause key's hint at the end of the line: "[space: pause]", or
+  /// "paused — space to resume" while `paused`; nothing unless `keys`.
+  void SetPauseState(bool keys, bool paused) {
+    pause_keys_ = keys;
+    paused_ = paused;
+  }
 
   /// Redraws at most 10 times a second (and always when `force`).
   /// `machine_seconds` > 0 for a simulated device.
@@ -122,6 +171,8 @@ class ProgressLine {
   bool shown_ = false;
   std::string layer_;
   const MachineSchedule* schedule_ = nullptr;
+  bool pause_keys_ = false;
+  bool paused_ = false;
   std::uint64_t last_executed_ = 0;
   Clock::time_point executed_changed_;
   Clock::time_point start_;

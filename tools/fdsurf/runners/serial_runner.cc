@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,6 +95,10 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   hal::SerialSpec spec;
   std::string error;
   if (!hal::ParseSerialDevice(o.device, &spec, &error)) throw InputError("--device: " + error);
+  if (spec.automatic && !o.resume.empty()) {
+    // Probing the ports starts new sessions, which would end the one to resume.
+    throw InputError("--resume needs the port named (serial:PATH), not serial:auto");
+  }
   const InterruptGuard interrupts;
   SerialSession session;
   if (spec.automatic) {
@@ -109,6 +114,8 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   TransportLoop& loop = *session.loop;
   loop.set_reconnect_timeout_ms(Milliseconds(o.reconnect_timeout_s));
   loop.set_no_pause(o.no_pause);
+  std::optional<std::uint32_t> old_executed;
+  if (o.resume_state) old_executed = loop.FinishOldSession(o.resume_state->session);
   if (!loop.Connect()) {
     std::fprintf(stderr, "fdsurf: interrupted before the device answered; nothing was sent\n");
     return 130;
@@ -116,9 +123,11 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   const std::string name = "serial " + session.port->path();
   const protocol::HelloReply hello = *loop.link().hello();
   const StreamJob fitted = FitJobToDevice(job, hello, name, o);
+  std::optional<JobJournal> journal;
+  const StreamJob to_run = JobWithJournal(o, job, fitted, old_executed, &loop, &journal);
   ProgressLine progress(ShowProgress(o.quiet));
-  progress.SetSchedule(o.schedule.get());
-  const int code = loop.Run(fitted, &progress);
+  progress.SetSchedule(o.resume_state ? nullptr : o.schedule.get());
+  const int code = loop.Run(to_run, &progress);
   if (code != 0 || o.quiet) return code;
   const HostLinkStats& stats = loop.link().stats();
   std::fprintf(stderr,

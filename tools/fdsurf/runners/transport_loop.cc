@@ -28,6 +28,8 @@ const char* StateName(protocol::DeviceState state) {
       return "stopping";
     case protocol::DeviceState::kFault:
       return "fault";
+    case protocol::DeviceState::kPaused:
+      return "paused";
   }
   return "unknown";
 }
@@ -85,6 +87,7 @@ void TransportLoop::Turn() {
   }
   out_.clear();
   link_.Poll(now, &out_);
+  if (journal_ != nullptr && link_.status()) journal_->Record(*link_.status());
   if (status != hal::IoStatus::kDisconnected && !out_.empty()) {
     status = transport_.Write(out_.data(), out_.size(), 1000);
   }
@@ -119,7 +122,10 @@ int TransportLoop::Run(const StreamJob& job, ProgressLine* progress) {
     progress->SetLayer(LayerLabel(job, from));
     Enqueue(job, &link_, from, to);
     if (!RunToRest(job.commands.size(), progress)) return StopAndReport(job.commands.size());
-    if (to == job.commands.size()) return 0;
+    if (to == job.commands.size()) {
+      if (journal_ != nullptr) journal_->Record(*link_.status(), true);
+      return 0;
+    }
     // The job lifts the pen before every layer start (stream.cc); the
     // device's own report must agree before anyone reaches for the pen.
     if (link_.status()->pen_down) {
@@ -140,11 +146,14 @@ int TransportLoop::Run(const StreamJob& job, ProgressLine* progress) {
 
 bool TransportLoop::RunToRest(std::uint64_t total_commands, ProgressLine* progress) {
   std::uint64_t last_progress = 0;
+  // Space or 'p' pauses and resumes (the terminal comes back on every way out).
+  PauseToggle pause(true, options_.quiet, progress);
   while (!link_.Finished() && !link_.Failed()) {
     if (InterruptGuard::Interrupted()) {
       progress->Finish();
       return false;
     }
+    pause.Poll(&link_);
     Turn();
     const std::uint64_t now = hal::MonotonicClock::Now();
     if (now - last_progress > 250'000) {
@@ -187,10 +196,12 @@ int TransportLoop::StopAndReport(std::uint64_t total_commands) {
   std::string state = "unknown";
   bool rest = false;
   while (hal::MonotonicClock::Now() < deadline && !link_.Failed()) {
+    if (InterruptGuard::Again()) return HaltAndReport();
     Turn();
     if (link_.StopAcknowledged() && (rest = AtRest(hal::MonotonicClock::Now(), &state))) break;
   }
   const std::uint64_t executed = rest_report_ ? rest_report_->executed : 0;
+  if (journal_ != nullptr && rest_report_) journal_->Record(*rest_report_, true);
   if (!link_.StopAcknowledged()) {
     std::fprintf(stderr,
                  "fdsurf: error: %s did not acknowledge STOP within %s: it may still be moving\n",
@@ -208,6 +219,87 @@ int TransportLoop::StopAndReport(std::uint64_t total_commands) {
                  options_.device.c_str(), state.c_str(), rest_report_->pen_down ? "down" : "up",
                  static_cast<unsigned long long>(executed),
                  static_cast<unsigned long long>(total_commands));
+  }
+  return 130;
+}
+
+void TransportLoop::set_journal(JobJournal* journal) {
+  journal_ = journal;
+  if (journal_ != nullptr) {
+    journal_->SetSession(link_.session());
+    journal_->Flush();
+  }
+}
+
+std::optional<std::uint32_t> TransportLoop::FinishOldSession(std::uint32_t session) {
+  HostLinkOptions options = LinkOptions();
+  options.new_session = false;
+  options.session = session;
+  HostLink old(options);
+  const std::uint64_t deadline =
+      hal::MonotonicClock::Now() + options_.reconnect_timeout_ms * 1000ull;
+  std::vector<std::uint8_t> out;
+  while (!old.Failed() && hal::MonotonicClock::Now() < deadline && !InterruptGuard::Interrupted()) {
+    const std::uint64_t now = hal::MonotonicClock::Now();
+    std::uint8_t in[512];
+    std::size_t got = 0;
+    if (transport_.Read(in, sizeof in, &got, 2) == hal::IoStatus::kOk) old.OnBytes(in, got, now);
+    out.clear();
+    old.Poll(now, &out);
+    if (!out.empty()) (void)transport_.Write(out.data(), out.size(), 1000);
+    // Nothing enqueued: Finished() once a report shows the device idle.
+    const auto& status = old.status();
+    if (old.Connected() && status && status->state == protocol::DeviceState::kIdle &&
+        status->queued == 0) {
+      return status->executed;
+    }
+    if (old.Connected() && status && status->state == protocol::DeviceState::kPaused) {
+      old.RequestResume();  // a paused device would never finish
+    }
+  }
+  return std::nullopt;
+}
+
+StreamJob JobWithJournal(const StreamOptions& o, const StreamJob& job, const StreamJob& fitted,
+                         std::optional<std::uint32_t> old_executed, TransportLoop* loop,
+                         std::optional<JobJournal>* journal) {
+  if (o.resume_state == nullptr) {
+    if (o.journal.empty()) return fitted;
+    journal->emplace(o.journal, job, 0, 0);
+    loop->set_journal(&**journal);
+    return fitted;
+  }
+  const JournalState& state = *o.resume_state;
+  const std::size_t executed = old_executed ? JobExecuted(state, *old_executed) : state.executed;
+  if (!o.quiet) {
+    std::fprintf(stderr, "fdsurf: resuming %s: %zu of %zu commands executed (%s)\n",
+                 o.resume.c_str(), executed, fitted.commands.size(),
+                 old_executed ? "as the device reports it"
+                              : "as the journal says: the device does not have the session");
+  }
+  std::size_t prefix = 0;
+  StreamJob rest = ResumedJob(fitted, executed, &prefix);
+  journal->emplace(o.journal.empty() ? o.resume : o.journal, job, executed, prefix);
+  loop->set_journal(&**journal);
+  return rest;
+}
+
+int TransportLoop::HaltAndReport() {
+  if (!options_.quiet) std::fprintf(stderr, "\nfdsurf: interrupted again: halting the device\n");
+  link_.RequestHalt();
+  const std::uint64_t deadline = hal::MonotonicClock::Now() + options_.halt_timeout_ms * 1000ull;
+  while (hal::MonotonicClock::Now() < deadline && !link_.Failed() && !link_.HaltAcknowledged()) {
+    Turn();
+  }
+  if (link_.HaltAcknowledged()) {
+    std::fprintf(stderr,
+                 "fdsurf: halted: %s stopped at once with the pen lifted and the motors "
+                 "disabled (the position may be lost: home before the next job)\n",
+                 options_.device.c_str());
+  } else {
+    std::fprintf(stderr,
+                 "fdsurf: error: %s did not acknowledge HALT within %s: it may still be moving\n",
+                 options_.device.c_str(), Seconds(options_.halt_timeout_ms * 1000ull).c_str());
   }
   return 130;
 }

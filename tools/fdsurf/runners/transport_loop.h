@@ -16,7 +16,11 @@
 // Ctrl-C (SIGINT) or SIGTERM (with an InterruptGuard, runner.h), also
 // during a pause: the first sends STOP, waits (bounded) for its
 // acknowledgement and for the device to report itself at rest, says what
-// was executed and makes Run() return 130; a second exits at once (130).
+// was executed and makes Run() return 130; a second sends HALT (stop at once,
+// pen up, motors off), waits briefly for its acknowledgement, returns 130.
+//
+// On a terminal, space or 'p' pauses the device (PAUSE: it decelerates along
+// the path, lifts the pen and holds) and the same key resumes it.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +30,7 @@
 #include "fdsurf/hal/transport.h"
 #include "fdsurf/host/link.h"
 #include "fdsurf/host/stream.h"
+#include "journal.h"
 #include "runner.h"
 
 namespace fdsurf::host {
@@ -40,6 +45,8 @@ struct TransportLoopOptions {
   std::uint32_t reconnect_timeout_ms = 30'000;
   /// After Ctrl-C: how long to wait for STOP's acknowledgement and for rest.
   std::uint32_t stop_timeout_ms = 10'000;
+  /// After a second Ctrl-C: how long to wait for HALT's acknowledgement.
+  std::uint32_t halt_timeout_ms = 2'000;
   bool quiet = false;
   /// Go on between layers without waiting for Enter (--no-pause).
   bool no_pause = false;
@@ -61,6 +68,17 @@ class TransportLoop {
   /// the job, and when it reports the pen down at a layer's end.
   int Run(const StreamJob& job, ProgressLine* progress);
 
+  /// Records the device's progress in `journal` (not owned; nullptr: none)
+  /// from now on, and once more at the end, at a stop and at a halt.
+  void set_journal(JobJournal* journal);
+
+  /// Before Connect(), for --resume: a resume HELLO for `session` (the
+  /// interrupted run's); if the device still has it, waits (at most
+  /// reconnect_timeout_ms) until it has executed everything it accepted and
+  /// returns its executed count: exact, where the journal may lag. nullopt
+  /// when the device does not have the session (reset, power loss).
+  std::optional<std::uint32_t> FinishOldSession(std::uint32_t session);
+
   FDSURF_NODISCARD HostLink& link() { return link_; }
   FDSURF_NODISCARD std::uint64_t reconnects() const { return reconnects_; }
   void set_reconnect_timeout_ms(std::uint32_t ms) { options_.reconnect_timeout_ms = ms; }
@@ -76,6 +94,8 @@ class TransportLoop {
   bool RunToRest(std::uint64_t total_commands, ProgressLine* progress);
   // After Ctrl-C: STOP, then status until the device is at rest.
   int StopAndReport(std::uint64_t total_commands);
+  // After a second Ctrl-C: HALT until acknowledged (briefly); 130.
+  int HaltAndReport();
   // Status queries of our own after STOP (HostLink sends nothing more):
   // true once a report says the device is idle or faulted.
   bool AtRest(std::uint64_t now_us, std::string* state);
@@ -91,7 +111,17 @@ class TransportLoop {
   std::uint16_t rest_token_ = 0xFF00;
   std::uint64_t rest_query_us_ = 0;
   std::optional<protocol::StatusReport> rest_report_;
+  JobJournal* journal_ = nullptr;
 };
+
+/// The job a usb or serial run sends, and its journal: with --resume the
+/// rest of `fitted` after what the device or the journal says was executed
+/// (ResumedJob; says so on stderr), else `fitted`; with --journal or
+/// --resume a journal (of `job`, the job as planned) in `*journal`, given to
+/// `loop`. `old_executed`: FinishOldSession's answer.
+StreamJob JobWithJournal(const StreamOptions& o, const StreamJob& job, const StreamJob& fitted,
+                         std::optional<std::uint32_t> old_executed, TransportLoop* loop,
+                         std::optional<JobJournal>* journal);
 
 /// Seconds (an option) as whole milliseconds, rounded up.
 std::uint32_t Milliseconds(double seconds);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "../cli_options.h"
@@ -29,11 +30,15 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
   options.quiet = o.quiet;
   options.no_pause = o.no_pause;
   TransportLoop loop(*usb, options);
+  std::optional<std::uint32_t> old_executed;
+  if (o.resume_state) old_executed = loop.FinishOldSession(o.resume_state->session);
   if (!loop.Connect()) return 130;
   const StreamJob fitted = FitJobToDevice(job, *loop.link().hello(), options.device, o);
+  std::optional<JobJournal> journal;
+  const StreamJob to_run = JobWithJournal(o, job, fitted, old_executed, &loop, &journal);
   ProgressLine progress(ShowProgress(o.quiet));
-  progress.SetSchedule(o.schedule.get());
-  const int code = loop.Run(fitted, &progress);
+  progress.SetSchedule(o.resume_state ? nullptr : o.schedule.get());
+  const int code = loop.Run(to_run, &progress);
   if (code != 0 || o.quiet) return code;
   std::fprintf(stderr, "%s: %s drawn by usb %s; %llu frames sent (%llu resent)\n", o.file.c_str(),
                JobContents(job).c_str(), selector.ToString().c_str(),

@@ -150,6 +150,12 @@ class Device {
     // After a fault the motion still comes to rest along its path and the
     // pen is lifted, unless the outputs themselves failed.
     if (outputs_failed_ || (fault_ && motion_.Idle())) return hal::IoStatus::kOk;
+    if (halt_outputs_ || pause_ != PausePhase::kNone) {
+      bool consumed = false;
+      const hal::IoStatus status = TickPauseOrHalt(steppers, pen, &consumed);
+      if (status != hal::IoStatus::kOk) return OutputFailed(status);
+      if (consumed) return status;
+    }
     const motion::TickOutput out = motion_.Tick();
     executed_ += out.commands_done;
     hal::IoStatus status = hal::IoStatus::kOk;
@@ -167,15 +173,7 @@ class Device {
       }
       if (status == hal::IoStatus::kOk) status = steppers.Step(out.step_mask);
     }
-    if (status != hal::IoStatus::kOk) {
-      // The queue is the main loop's: Fill() drops it on seeing fault_.
-      outputs_failed_ = true;
-      error_ = protocol::ErrorCode::kOutputFailed;
-      error_detail_ = static_cast<uint8_t>(status);
-      fault_ = true;
-      motion_.Stop();
-      return status;
-    }
+    if (status != hal::IoStatus::kOk) return OutputFailed(status);
     return hal::IoStatus::kOk;
   }
 
@@ -241,6 +239,8 @@ class Device {
     const InterruptLock lock;
     if (fault_) {
       report->state = protocol::DeviceState::kFault;
+    } else if (pause_ != PausePhase::kNone) {
+      report->state = protocol::DeviceState::kPaused;
     } else if (motion_.Stopping()) {
       report->state = protocol::DeviceState::kStopping;
     } else {
@@ -248,7 +248,8 @@ class Device {
     }
     report->error = error_;
     report->error_detail = error_detail_;
-    report->pen_down = motion_.pen_down();
+    // The pen as it is: a pause lifts it behind the motion loop's back.
+    report->pen_down = motion_.pen_down() && !pen_lifted_by_pause_;
     for (int a = 0; a < protocol::kMaxAxes; ++a) report->position[a] = motion_.position()[a];
     report->queued = static_cast<uint8_t>(queued_);
     report->credits = Credits();
@@ -262,11 +263,55 @@ class Device {
   void Stop() {
     DropQueue();
     const InterruptLock lock;
+    EndPause();
     if (motion_.Idle()) {
       FinishStop();
     } else {
       motion_.Stop();
     }
+  }
+
+  /// PAUSE: the motion decelerates to rest along its path (as for STOP) but
+  /// the queue and the buffer are kept; at rest the pen, if down, is lifted
+  /// and the pen delay waited; then it holds (STATUS: kPaused). Commands are
+  /// still accepted and expanded meanwhile. Ignored during a stop or a fault
+  /// and when already paused.
+  void Pause() {
+    const InterruptLock lock;
+    if (fault_ || motion_.Stopping() || pause_ != PausePhase::kNone) return;
+    motion_.Pause();
+    pause_ = PausePhase::kBraking;
+  }
+
+  /// RESUME: the pen is lowered again if the pause lifted it (with the pen
+  /// delay), then the motion goes on from where it rests. A resume while
+  /// still decelerating just goes on. Ignored when not paused.
+  void Resume() {
+    const InterruptLock lock;
+    if (pause_ == PausePhase::kNone) return;
+    if (pen_lifted_by_pause_) {
+      pause_ = PausePhase::kLowering;
+      pause_wait_ = 0;
+      lower_pending_ = true;
+    } else {
+      EndPause();
+    }
+  }
+
+  /// HALT, the emergency stop: the queue and the buffer are dropped at once
+  /// with no deceleration (steps may be lost on a real machine: the position
+  /// is then only what was commanded), and on the next tick the pen is
+  /// lifted and the drivers disabled (they are enabled again by the next
+  /// step). Configuration and counters are kept.
+  void Halt() {
+    DropQueue();
+    const InterruptLock lock;
+    EndPause();
+    // The buffer goes at once; the motion loop's own pen state follows
+    // through a pen-up entry, while the outputs are written directly by the
+    // next Tick().
+    FinishStop();
+    halt_outputs_ = true;
   }
 
   /// A new session: as STOP, and the configuration and counters are
@@ -299,6 +344,7 @@ class Device {
     error_ = protocol::ErrorCode::kNone;
     error_detail_ = 0;
     generator_.Reset(motion_.position(), false);
+    pause_ = PausePhase::kNone;
   }
 
   // A configuration takes effect once everything before it has been
@@ -336,6 +382,79 @@ class Device {
     --queued_;
   }
 
+  // The pause or the halt's share of a tick; *consumed when the tick is
+  // spent (the motion loop is not run).
+  hal::IoStatus TickPauseOrHalt(hal::StepDirOutputs& steppers, hal::PenOutput& pen,
+                                bool* consumed) {
+    if (halt_outputs_) {
+      halt_outputs_ = false;
+      hal::IoStatus status = pen.SetPen(false);
+      if (status == hal::IoStatus::kOk) status = steppers.SetEnabled(false);
+      enabled_ = false;
+      *consumed = true;
+      return status;
+    }
+    *consumed = pause_ != PausePhase::kBraking;
+    switch (pause_) {
+      case PausePhase::kBraking:
+        if (!motion_.HeldAtPause()) return hal::IoStatus::kOk;  // still decelerating
+        *consumed = true;
+        if (!motion_.pen_down()) {
+          pause_ = PausePhase::kHeld;
+          return hal::IoStatus::kOk;
+        }
+        pen_lifted_by_pause_ = true;
+        pause_ = PausePhase::kLifting;
+        pause_wait_ = motion_.limits().pen_delay_ticks;
+        return pen.SetPen(false);
+      case PausePhase::kLifting:
+        if (pause_wait_ > 0) {
+          --pause_wait_;
+        } else {
+          pause_ = PausePhase::kHeld;
+        }
+        return hal::IoStatus::kOk;
+      case PausePhase::kLowering:
+        if (lower_pending_) {
+          lower_pending_ = false;
+          pen_lifted_by_pause_ = false;
+          pause_wait_ = motion_.limits().pen_delay_ticks;
+          return pen.SetPen(true);
+        }
+        if (pause_wait_ > 0) {
+          --pause_wait_;
+        } else {
+          EndPause();
+        }
+        return hal::IoStatus::kOk;
+      case PausePhase::kHeld:
+      case PausePhase::kNone:
+        return hal::IoStatus::kOk;
+    }
+    return hal::IoStatus::kOk;
+  }
+
+  // Also on STOP, HALT and faults: a pen the pause lifted stays up (they
+  // lift it anyway, through the buffer).
+  void EndPause() {
+    pause_ = PausePhase::kNone;
+    pen_lifted_by_pause_ = false;
+    pause_wait_ = 0;
+    lower_pending_ = false;
+    motion_.Resume();
+  }
+
+  hal::IoStatus OutputFailed(hal::IoStatus status) {
+    // The queue is the main loop's: Fill() drops it on seeing fault_.
+    outputs_failed_ = true;
+    error_ = protocol::ErrorCode::kOutputFailed;
+    error_detail_ = static_cast<uint8_t>(status);
+    fault_ = true;
+    EndPause();
+    motion_.Stop();
+    return status;
+  }
+
   void FinishStop() {
     motion_.Clear();
     generator_.Reset(motion_.position(), motion_.pen_down());
@@ -349,11 +468,16 @@ class Device {
   void Fault(protocol::ErrorCode error, uint8_t detail) {
     DropQueue();
     const InterruptLock lock;
+    EndPause();
     fault_ = true;
     error_ = error;
     error_detail_ = detail;
     motion_.Stop();
   }
+
+  // A pause's course: decelerating, lifting the pen (pen delay), holding,
+  // lowering it again at RESUME (pen delay), then kNone.
+  enum class PausePhase : uint8_t { kNone, kBraking, kLifting, kHeld, kLowering };
 
   uint32_t tick_hz_;
   protocol::DeviceLink<Device> link_;
@@ -373,6 +497,11 @@ class Device {
   uint8_t error_detail_;
   uint32_t executed_;
   motion::ValidationWork validation_work_ = {0, 0};
+  PausePhase pause_ = PausePhase::kNone;
+  uint32_t pause_wait_ = 0;           // pen delay ticks left in kLifting/kLowering
+  bool pen_lifted_by_pause_ = false;  // the pen is up only because of the pause
+  bool lower_pending_ = false;        // kLowering: the pen is yet to be lowered
+  bool halt_outputs_ = false;         // HALT: pen up and drivers off on the next tick
 };
 
 }  // namespace device

@@ -104,8 +104,24 @@ class MotionLoop {
 
   /// Decelerates to rest along the buffered path as fast as the limits
   /// allow, then drops whatever is left. Stopped() tells when that is done.
-  void Stop() { stopping_ = true; }
+  void Stop() {
+    stopping_ = true;
+    pausing_ = false;
+  }
   FDSURF_NODISCARD bool Stopping() const { return stopping_; }
+
+  /// Decelerates to rest along the buffered path as Stop() does, but keeps
+  /// the buffer and holds there (no entry, pen event or not, is passed)
+  /// until Resume(), which accelerates from rest again where it stopped. A
+  /// pause during a pen delay lets the delay run out first. No step is lost
+  /// or repeated: the position within the head move is kept.
+  void Pause() {
+    if (!stopping_) pausing_ = true;
+  }
+  void Resume() { pausing_ = false; }
+  FDSURF_NODISCARD bool Pausing() const { return pausing_; }
+  /// Paused and at rest: nothing moves until Resume().
+  FDSURF_NODISCARD bool HeldAtPause() const { return pausing_ && speed_ == 0 && pen_wait_ == 0; }
 
   /// Forgets the buffer and the motion state (the caller has made sure the
   /// machine is at rest). Position and counters are kept.
@@ -149,6 +165,7 @@ class MotionLoop {
   uint32_t moves_ = 0;
   bool pen_down_ = false;
   bool stopping_ = false;
+  bool pausing_ = false;
 };
 
 }  // namespace motion

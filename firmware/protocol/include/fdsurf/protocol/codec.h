@@ -143,6 +143,10 @@ size_t EncodeFrame(MessageType type, uint16_t seq, const uint8_t* body, size_t b
 size_t EncodeHello(uint16_t token, const Hello& hello, uint8_t* out, size_t capacity);
 size_t EncodeStatusQuery(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
 size_t EncodeStop(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
+/// kPause, kResume, kHalt (empty bodies, like kStop).
+size_t EncodePause(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
+size_t EncodeResume(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
+size_t EncodeHalt(uint16_t token, uint8_t* out, size_t capacity, uint32_t session = 0);
 size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, size_t capacity,
                         uint32_t session = 0);
 size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* out, size_t capacity,
@@ -168,7 +172,7 @@ DecodeResult ValidateFields(const Command& command);
 /// change the rest of the body; else kBadLength, kBadField (unknown flags,
 /// session 0).
 DecodeResult DecodeHello(const Frame& frame, Hello* out);
-/// kStatusQuery and kStop: the body must be empty (kBadLength, field 0).
+/// kStatusQuery, kStop, kPause, kResume and kHalt: the body must be empty (kBadLength, field 0).
 DecodeResult DecodeEmpty(const Frame& frame);
 /// Any device → host message. Errors: kUnknownType, kBadLength, kBadField.
 DecodeResult DecodeReply(const Frame& frame, Reply* out);

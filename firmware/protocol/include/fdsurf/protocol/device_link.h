@@ -12,7 +12,8 @@
 //  - A seq ahead of next_seq (something before it was lost) → NAK(next_seq,
 //    credits, kOutOfOrder), dropped; the host goes back to next_seq.
 //  - The expected seq with no credit left → NAK(next_seq, 0, kQueueFull).
-//  - HELLO, STATUS_QUERY and STOP are answered at once and echo their token.
+//  - HELLO, STATUS_QUERY, STOP, PAUSE, RESUME and HALT are answered at once
+//    and echo their token.
 //  - Sessions (protocol version 2): a new-session HELLO names the session;
 //    every other frame, both ways, carries its tag in the CRC (frame.h). A
 //    frame of another session fails the CRC check and is dropped unanswered;
@@ -38,6 +39,9 @@
 //   // Everything but next_seq (the link sets that).
 //   void FillStatus(protocol::StatusReport* report) const;
 //   void Stop();   // STOP: stop motion, drop the queue
+//   void Pause();  // PAUSE: come to rest along the path, keep the queue, hold
+//   void Resume(); // RESUME: go on after a pause (nothing if not paused)
+//   void Halt();   // HALT: stop at once, drop everything, motors off
 //   void Reset();  // new session: drop the queue and all state (HELLO flag)
 #pragma once
 
@@ -62,6 +66,9 @@ struct DeviceLinkStats {
   uint32_t hellos;             ///< HELLOs answered (new session or resume)
   uint32_t status_queries;
   uint32_t stops;
+  uint32_t pauses;           ///< PAUSE frames handled (repeats included)
+  uint32_t resumes;          ///< RESUME frames handled
+  uint32_t halts;            ///< HALT frames handled
   uint32_t replies_dropped;  ///< no room in the output buffer
   /// Frames with the plain CRC that need a session (all but HELLO), or any
   /// frame but HELLO before the first session: dropped unanswered. Frames of
@@ -166,10 +173,36 @@ class DeviceLink {
         SendAck(frame.seq);
         return;
       }
+      case MessageType::kPause:
+      case MessageType::kResume:
+      case MessageType::kHalt:
+        HandleControl(type, frame);
+        return;
       default:
         SendError(frame.seq, ErrorCode::kUnknownType, 0);
         return;
     }
+  }
+
+  // PAUSE, RESUME, HALT: empty bodies, idempotent, acknowledged at once
+  // (a retransmission after a lost ACK does nothing new).
+  void HandleControl(MessageType type, const Frame& frame) {
+    const DecodeResult result = DecodeEmpty(frame);
+    if (!result.ok()) {
+      SendError(frame.seq, result.code, result.field);
+      return;
+    }
+    if (type == MessageType::kPause) {
+      ++stats_.pauses;
+      sink_->Pause();
+    } else if (type == MessageType::kResume) {
+      ++stats_.resumes;
+      sink_->Resume();
+    } else {
+      ++stats_.halts;
+      sink_->Halt();
+    }
+    SendAck(frame.seq);
   }
 
   void HandleHello(const Frame& frame) {

@@ -20,7 +20,8 @@ namespace protocol {
 
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
 /// the session id (Hello::session), folded into the CRC of every other frame.
-constexpr uint8_t kProtocolVersion = 2;
+/// Version 3 adds PAUSE, RESUME and HALT (and the other rows of issue 15).
+constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -33,6 +34,14 @@ enum class MessageType : uint8_t {
   kHello = 0x01,        ///< version and flags; answered by kHelloReply
   kStatusQuery = 0x02,  ///< answered by kStatusReport
   kStop = 0x03,         ///< stop motion, drop the queue; answered by kAck
+  /// Decelerate to rest along the path, keep queue and buffer, lift the pen,
+  /// hold (DeviceState::kPaused); answered by kAck.
+  kPause = 0x04,
+  /// Lower the pen again if the pause lifted it, go on; answered by kAck.
+  kResume = 0x05,
+  /// Emergency stop: at once (no deceleration), drop queue and buffer, lift
+  /// the pen, disable the motors; answered by kAck.
+  kHalt = 0x06,
 
   kConfig = 0x10,  ///< MachineConfig
   kPatch = 0x11,   ///< PatchCommand
@@ -174,6 +183,7 @@ enum class DeviceState : uint8_t {
   kRunning = 1,   ///< executing or about to
   kStopping = 2,  ///< decelerating after kStop
   kFault = 3,     ///< an execution error; `error` says which
+  kPaused = 4,    ///< decelerating to, or holding at, a pause (kPause)
 };
 
 struct HelloReply {
@@ -220,7 +230,7 @@ struct Nak {
 };
 
 /// Every reply's frame seq field echoes the seq (or, for HELLO, STATUS_QUERY
-/// and STOP, the token) of the frame it answers; ACK, NAK and ERROR bodies
+/// STOP, PAUSE, RESUME and HALT, the token) of the frame it answers; ACK, NAK and ERROR bodies
 /// carry the fields below.
 struct ErrorReply {
   /// The refused frame's sequence number (its token for unsequenced frames);

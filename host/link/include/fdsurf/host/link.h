@@ -131,7 +131,25 @@ class HostLink {
 
   /// Sends STOP (repeated until acknowledged) and no further commands.
   void RequestStop();
-  FDSURF_NODISCARD bool StopAcknowledged() const { return stop_acked_; }
+  FDSURF_NODISCARD bool StopAcknowledged() const { return stop_acked_ && !halt_; }
+
+  /// PAUSE and RESUME (protocol version 3): sent, and repeated every
+  /// retransmit timeout until the ACK echoing the token arrives; commands
+  /// keep flowing meanwhile (the device queues them while it holds). A new
+  /// request replaces one not yet acknowledged. Ignored after a stop.
+  void RequestPause();
+  void RequestResume();
+  /// The last pause or resume request is acknowledged (and was a pause).
+  FDSURF_NODISCARD bool PauseAcknowledged() const {
+    return control_acked_ && control_type_ == protocol::MessageType::kPause;
+  }
+  FDSURF_NODISCARD bool ResumeAcknowledged() const {
+    return control_acked_ && control_type_ == protocol::MessageType::kResume;
+  }
+  /// HALT, the emergency stop: sent instead of STOP (also after one), and
+  /// repeated until acknowledged; nothing else is sent afterwards.
+  void RequestHalt();
+  FDSURF_NODISCARD bool HaltAcknowledged() const { return stop_acked_ && halt_; }
 
   /// Handshake done (a HELLO_REPLY arrived since the last Resume()).
   FDSURF_NODISCARD bool Connected() const { return state_ == State::kRunning; }
@@ -183,6 +201,10 @@ class HostLink {
   // once nothing progressed for give_up_after_us.
   bool Timeout(uint64_t now_us, std::vector<uint8_t>* out);
   void SendStop(std::vector<uint8_t>* out);
+  // PAUSE or RESUME, when one is due; false when giving up.
+  bool PollControl(uint64_t now_us, std::vector<uint8_t>* out);
+  // NextPollUs() for the commands, status queries and the give-up clock.
+  FDSURF_NODISCARD uint64_t NextCommandPollUs(uint64_t now_us) const;
   void Progress(uint64_t now_us);
   FDSURF_NODISCARD std::string Describe(size_t index) const;
   FDSURF_NODISCARD uint16_t SeqOf(size_t index) const {
@@ -223,6 +245,14 @@ class HostLink {
   uint16_t stop_token_ = 0;
   uint64_t stop_sent_us_ = 0;
   bool stop_sent_ = false;
+  bool halt_ = false;  // the stop is a HALT
+
+  bool control_requested_ = false;  // a PAUSE or RESUME is wanted
+  protocol::MessageType control_type_ = protocol::MessageType::kPause;
+  bool control_sent_ = false;
+  bool control_acked_ = false;
+  uint16_t control_token_ = 0;
+  uint64_t control_sent_us_ = 0;
 
   int retries_ = 0;           // consecutive timeouts without progress
   uint64_t rto_us_ = 0;       // the retransmit timeout now (backed off)
