@@ -19,8 +19,9 @@ namespace fdsurf {
 namespace protocol {
 
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
-/// the session id (Hello::session), folded into the CRC of every other frame.
-constexpr uint8_t kProtocolVersion = 2;
+/// the session id (Hello::session), folded into the CRC of every other frame;
+/// version 3 the machine's pen hardware and limits in CONFIG (issue 15).
+constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -86,6 +87,11 @@ struct MachineConfig {
   uint32_t accel;
   /// Rest after every pen change before motion resumes, milliseconds.
   uint16_t pen_delay_ms;
+  /// A hobby-servo pen lift's pulse widths, µs, every 20 ms: with the pen up
+  /// and with it down. Both 0: the pen output is a plain switch; else each
+  /// in 500..2500 (hal/pwm.h ServoPen).
+  uint16_t servo_up_us;
+  uint16_t servo_down_us;
 };
 
 /// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a
