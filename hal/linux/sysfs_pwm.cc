@@ -113,10 +113,6 @@ IoStatus SysfsPwm::Open(const SysfsPwmConfig& config, std::unique_ptr<SysfsPwm>*
   return IoStatus::kOk;
 }
 
-SysfsPwm::~SysfsPwm() {
-  if (enabled_) (void)Write("enable", 0);
-}
-
 IoStatus SysfsPwm::Write(const char* attribute, uint64_t value) {
   std::string detail;
   const IoStatus status = WriteSysfsFile(dir_ + "/" + attribute, std::to_string(value), &detail);
@@ -161,13 +157,7 @@ IoStatus SysfsPwm::DoSetPulseMicros(uint32_t pulse_us) {
   return IoStatus::kOk;
 }
 
-IoStatus SysfsPwm::DoSetEnabled(bool enabled) {
-  if (const IoStatus status = Write("enable", enabled ? 1 : 0); status != IoStatus::kOk) {
-    return status;
-  }
-  enabled_ = enabled;
-  return IoStatus::kOk;
-}
+IoStatus SysfsPwm::DoSetEnabled(bool enabled) { return Write("enable", enabled ? 1 : 0); }
 
 }  // namespace hal
 }  // namespace fdsurf

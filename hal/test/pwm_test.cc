@@ -150,7 +150,9 @@ TEST_F(SysfsPwmTest, ServoPenWritesNanosecondsToTheChannel) {
   ASSERT_EQ(as_pen.ConfigureServo(1100, 1900), IoStatus::kOk);
   ASSERT_EQ(as_pen.SetPen(true), IoStatus::kOk);
   EXPECT_EQ(Read("pwmchip0/pwm1/duty_cycle"), "1900000");
-  pwm.reset();  // the destructor stops the pulses
+  ASSERT_EQ(pwm->SetEnabled(false), IoStatus::kOk);
+  EXPECT_EQ(Read("pwmchip0/pwm1/enable"), "0");
+  pwm.reset();  // the destructor leaves the channel as it is (a limp servo may drop the pen)
   EXPECT_EQ(Read("pwmchip0/pwm1/enable"), "0");
 }
 

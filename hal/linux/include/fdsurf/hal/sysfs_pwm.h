@@ -36,8 +36,10 @@ struct SysfsPwmConfig {
 };
 
 /// A PWM channel through sysfs. Open() exports the channel if pwmM/ is not
-/// there yet; the destructor disables it (and leaves it exported: another
-/// program may hold it, and unexporting resets the pin's mux on some SoCs).
+/// there yet. The destructor leaves the channel as it is, pulsing and
+/// exported: a servo without pulses goes limp and could let a lifted pen
+/// drop, so the caller lifts the pen before and SetEnabled(false) is its
+/// choice; unexporting resets the pin's mux on some SoCs.
 ///
 /// Errors name the file and what the kernel said, e.g.
 ///   "pwm: no PWM chip /sys/class/pwm/pwmchip3 (chips present: pwmchip0)"
@@ -53,7 +55,7 @@ class SysfsPwm final : public PwmOutput {
   static IoStatus Open(const SysfsPwmConfig& config, std::unique_ptr<SysfsPwm>* pwm,
                        std::string* error);
 
-  ~SysfsPwm();
+  ~SysfsPwm() = default;
   SysfsPwm(const SysfsPwm&) = delete;
   SysfsPwm& operator=(const SysfsPwm&) = delete;
 
@@ -74,7 +76,6 @@ class SysfsPwm final : public PwmOutput {
   uint32_t period_us_ = 0;
   uint32_t pulse_us_ = 0;
   bool period_known_ = false;
-  bool enabled_ = false;
   std::string last_error_;
 };
 
