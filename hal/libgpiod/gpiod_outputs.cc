@@ -65,6 +65,26 @@ bool ParseLine(std::string_view field, bool default_active_low, GpioLine* line) 
   return true;
 }
 
+// A decimal of 1..6 digits.
+bool ParseNumber(std::string_view text, unsigned* value) {
+  if (text.empty() || text.size() > 6) return false;
+  *value = 0;
+  for (const char c : text) {
+    if (c < '0' || c > '9') return false;
+    *value = *value * 10 + static_cast<unsigned>(c - '0');
+  }
+  return true;
+}
+
+// PEN as "pwmN.M": chip N, channel M of the kernel's PWM class.
+bool ParsePwmPen(std::string_view field, unsigned* chip, unsigned* channel) {
+  if (field.substr(0, 3) != "pwm") return false;
+  field.remove_prefix(3);
+  const size_t dot = field.find('.');
+  return dot != std::string_view::npos && ParseNumber(field.substr(0, dot), chip) &&
+         ParseNumber(field.substr(dot + 1), channel);
+}
+
 }  // namespace
 
 bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* error) {
@@ -126,7 +146,17 @@ bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* er
   const std::string_view enable = fields[fields.size() - 2];
   parsed.has_enable = enable != "-";
   if (parsed.has_enable && !take(enable, "EN", true, &parsed.enable)) return false;
-  if (!take(fields.back(), "PEN", false, &parsed.pen)) return false;
+  const std::string_view pen = fields.back();
+  if (pen.substr(0, 3) == "pwm") {
+    parsed.has_pen_line = false;
+    if (!ParsePwmPen(pen, &parsed.pen_pwm_chip, &parsed.pen_pwm_channel)) {
+      *error = "gpio device " + quoted + ": PEN '" + std::string(pen) +
+               "' is not a PWM channel (pwmCHIP.CHANNEL, e.g. pwm0.1)";
+      return false;
+    }
+  } else if (!take(pen, "PEN", false, &parsed.pen)) {
+    return false;
+  }
   *config = std::move(parsed);
   return true;
 }
@@ -144,9 +174,11 @@ GpiodOutputs::GpiodOutputs(const GpiodConfig& config, gpiod_chip* chip)
     line_config_[line_count_] = config.enable;
     line_names_[line_count_++] = "EN";
   }
-  pen_index_ = line_count_;
-  line_config_[line_count_] = config.pen;
-  line_names_[line_count_++] = "PEN";
+  if (config.has_pen_line) {
+    pen_index_ = line_count_;
+    line_config_[line_count_] = config.pen;
+    line_names_[line_count_++] = "PEN";
+  }
 }
 
 IoStatus GpiodOutputs::Open(const GpiodConfig& config, std::unique_ptr<GpiodOutputs>* outputs,
@@ -233,7 +265,7 @@ GpiodOutputs::~GpiodOutputs() {
   const bool all_requested = lines_[line_count_ - 1] != nullptr;
   if (all_requested) {
     // Leave the machine safe: pen up, motors off (errors cannot be reported).
-    (void)Set(pen_index_, false);
+    if (pen_index_ >= 0) (void)Set(pen_index_, false);
     if (enable_index_ >= 0) (void)Set(enable_index_, false);
   }
   for (gpiod_line* line : lines_) {
@@ -305,7 +337,10 @@ IoStatus GpiodOutputs::DoStep(uint8_t axis_mask) {
   return result;
 }
 
-IoStatus GpiodOutputs::DoSetPen(bool down) { return Set(pen_index_, down); }
+IoStatus GpiodOutputs::DoSetPen(bool down) {
+  if (pen_index_ < 0) return IoStatus::kOk;  // a PWM servo pen, driven by the caller
+  return Set(pen_index_, down);
+}
 
 }  // namespace hal
 }  // namespace fdsurf

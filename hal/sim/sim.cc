@@ -79,6 +79,53 @@ IoStatus SimPen::DoSetPen(bool down) {
   return IoStatus::kOk;
 }
 
+// ---------------------------------------------------------------- pwm
+
+IoStatus SimPwm::Injected() {
+  const IoStatus status = injected_;
+  injected_ = IoStatus::kOk;
+  if (status != IoStatus::kOk)
+    last_error_ = std::string("sim pwm: injected ") + IoStatusName(status);
+  return status;
+}
+
+void SimPwm::Record(uint32_t period_us, uint32_t pulse_us, bool enabled) {
+  if (period_us == period_us_ && pulse_us == pulse_us_ && enabled == enabled_) return;
+  period_us_ = period_us;
+  pulse_us_ = pulse_us;
+  enabled_ = enabled;
+  events_.push_back({clock_.now_us(), period_us_, pulse_us_, enabled_});
+}
+
+IoStatus SimPwm::DoSetPeriodMicros(uint32_t period_us) {
+  if (const IoStatus status = Injected(); status != IoStatus::kOk) return status;
+  if (period_us == 0 || period_us > max_period_us_ || period_us < pulse_us_) {
+    last_error_ = "sim pwm: period " + std::to_string(period_us) + " us refused (1.." +
+                  std::to_string(max_period_us_) + ", not below the pulse of " +
+                  std::to_string(pulse_us_) + " us)";
+    return IoStatus::kInvalidArgument;
+  }
+  Record(period_us, pulse_us_, enabled_);
+  return IoStatus::kOk;
+}
+
+IoStatus SimPwm::DoSetPulseMicros(uint32_t pulse_us) {
+  if (const IoStatus status = Injected(); status != IoStatus::kOk) return status;
+  if (pulse_us > period_us_) {
+    last_error_ = "sim pwm: pulse " + std::to_string(pulse_us) + " us is longer than the period (" +
+                  std::to_string(period_us_) + " us)";
+    return IoStatus::kInvalidArgument;
+  }
+  Record(period_us_, pulse_us, enabled_);
+  return IoStatus::kOk;
+}
+
+IoStatus SimPwm::DoSetEnabled(bool enabled) {
+  if (const IoStatus status = Injected(); status != IoStatus::kOk) return status;
+  Record(period_us_, pulse_us_, enabled);
+  return IoStatus::kOk;
+}
+
 // ---------------------------------------------------------------- transport pair
 
 SimTransportPair::SimTransportPair(SimClock& clock, const SimLinkOptions& options)

@@ -6,4 +6,5 @@
 #include "fdsurf/hal/clock.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/hal/outputs.h"
+#include "fdsurf/hal/pwm.h"
 #include "fdsurf/hal/transport.h"

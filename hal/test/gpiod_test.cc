@@ -68,6 +68,30 @@ TEST_F(GpiodTest, OpenRequestsEveryLineInactive) {
   EXPECT_STREQ(outputs->LastError(), "");
 }
 
+// PEN as pwmN.M: a servo on a PWM channel, which the caller drives; no pen
+// line is requested, and SetPen() here changes no line.
+TEST_F(GpiodTest, APwmPenRequestsNoPenLine) {
+  GpiodConfig config;
+  std::string error;
+  ASSERT_TRUE(ParseGpioDevice("gpio:gpiochip0:17,27,22,23,24,pwm2.1", &config, &error)) << error;
+  EXPECT_FALSE(config.has_pen_line);
+  EXPECT_EQ(config.pen_pwm_chip, 2u);
+  EXPECT_EQ(config.pen_pwm_channel, 1u);
+  std::unique_ptr<GpiodOutputs> outputs;
+  ASSERT_EQ(GpiodOutputs::Open(config, &outputs, &error), IoStatus::kOk) << error;
+  EXPECT_EQ(fake_.log, (Log{"lookup gpiochip0", "request 17 fdsurf 0", "request 27 fdsurf 0",
+                            "request 22 fdsurf 0", "request 23 fdsurf 0", "request 24 fdsurf 1"}));
+  fake_.log.clear();
+  EXPECT_EQ(static_cast<PenOutput&>(*outputs).SetPen(true), IoStatus::kOk);
+  EXPECT_TRUE(fake_.log.empty());
+  for (const char* bad :
+       {"gpio:gpiochip0:17,27,22,23,24,pwm0", "gpio:gpiochip0:17,27,22,23,24,pwmx.1",
+        "gpio:gpiochip0:17,27,22,23,24,pwm0."}) {
+    EXPECT_FALSE(ParseGpioDevice(bad, &config, &error)) << bad;
+    EXPECT_NE(error.find("is not a PWM channel (pwmCHIP.CHANNEL"), std::string::npos) << error;
+  }
+}
+
 TEST_F(GpiodTest, StepGoesHighThenLowForAtLeastThePulseWidth) {
   GpiodConfig config;
   config.min_pulse_us = 50;

@@ -135,13 +135,12 @@ double WaveformHeader::Number(const std::string& key, double fallback) const {
 
 // --- Writing ------------------------------------------------------------------
 
-std::vector<Transition> TransitionsFromEvents(const WaveformHeader& header,
-                                              const std::vector<hal::StepDirEvent>& steps,
-                                              const std::vector<hal::PenEvent>& pens,
-                                              const WaveformWriteOptions& options) {
-  if (header.pen != PenKind::kLine) {
-    throw std::invalid_argument("the simulated plotter's waveform has a PEN line, not a servo");
-  }
+namespace {
+
+// The STEP/DIR/EN pins of the recorded step events, appended to `out`.
+void AppendStepDir(const WaveformHeader& header, const std::vector<hal::StepDirEvent>& steps,
+                   const WaveformWriteOptions& options, std::vector<Transition>* transitions) {
+  std::vector<Transition>& out = *transitions;
   const auto dir_level = [&](bool negative) {
     return static_cast<std::uint8_t>(negative ? header.dir_negative_level
                                               : 1 - header.dir_negative_level);
@@ -150,13 +149,11 @@ std::vector<Transition> TransitionsFromEvents(const WaveformHeader& header,
     return static_cast<std::uint8_t>(on ? header.enable_active_level
                                         : 1 - header.enable_active_level);
   };
-  std::vector<Transition> out;
   for (int axis = 0; axis < options.axes; ++axis) {
     out.push_back({0, StepSignal(axis), 0});
     out.push_back({0, DirSignal(axis), dir_level(false)});
     out.push_back({0, EnableSignal(axis), enable_level(false)});
   }
-  out.push_back({0, WaveSignal::kPen, static_cast<std::uint8_t>(1 - header.pen_down_level)});
   std::uint8_t negative = 0;
   bool enabled = false;
   for (const hal::StepDirEvent& e : steps) {
@@ -177,14 +174,91 @@ std::vector<Transition> TransitionsFromEvents(const WaveformHeader& header,
       out.push_back({rise + options.pulse_ns, StepSignal(axis), 0});
     }
   }
+}
+
+void SortByTime(std::vector<Transition>* out) {
+  std::stable_sort(out->begin(), out->end(),
+                   [](const Transition& a, const Transition& b) { return a.time_ns < b.time_ns; });
+}
+
+// The settings in force at `t_us`: the last event at or before it.
+const hal::PwmEvent* PwmAt(const std::vector<hal::PwmEvent>& events, std::uint64_t t_us) {
+  const hal::PwmEvent* in_force = nullptr;
+  for (const hal::PwmEvent& e : events) {
+    if (e.time_us > t_us) break;
+    in_force = &e;
+  }
+  return in_force;
+}
+
+}  // namespace
+
+std::vector<Transition> TransitionsFromEvents(const WaveformHeader& header,
+                                              const std::vector<hal::StepDirEvent>& steps,
+                                              const std::vector<hal::PenEvent>& pens,
+                                              const WaveformWriteOptions& options) {
+  if (header.pen != PenKind::kLine) {
+    throw std::invalid_argument("the simulated plotter's waveform has a PEN line, not a servo");
+  }
+  std::vector<Transition> out;
+  AppendStepDir(header, steps, options, &out);
+  out.push_back({0, WaveSignal::kPen, static_cast<std::uint8_t>(1 - header.pen_down_level)});
   for (const hal::PenEvent& p : pens) {
     const std::int64_t t = static_cast<std::int64_t>(p.time_us) * 1000;
     out.push_back(
         {t, WaveSignal::kPen,
          static_cast<std::uint8_t>(p.down ? header.pen_down_level : 1 - header.pen_down_level)});
   }
-  std::stable_sort(out.begin(), out.end(),
-                   [](const Transition& a, const Transition& b) { return a.time_ns < b.time_ns; });
+  SortByTime(&out);
+  return out;
+}
+
+std::vector<Transition> ServoTransitionsFromPwm(const std::vector<hal::PwmEvent>& pwm,
+                                                std::uint64_t end_us) {
+  std::vector<Transition> out;
+  out.push_back({0, WaveSignal::kServo, 0});
+  // Periods start when the channel is enabled and follow each other while it
+  // stays enabled; each pulses the width in force at its start.
+  std::uint64_t start_us = 0;
+  bool running = false;
+  for (std::size_t i = 0; i < pwm.size(); ++i) {
+    const hal::PwmEvent& e = pwm[i];
+    if (!e.enabled) {
+      running = false;
+      continue;
+    }
+    if (!running) {
+      running = true;
+      start_us = e.time_us;
+    }
+    const std::uint64_t until_us = i + 1 < pwm.size() ? pwm[i + 1].time_us : end_us;
+    while (start_us <= until_us && start_us < end_us) {
+      const hal::PwmEvent* now = PwmAt(pwm, start_us);
+      if (now == nullptr || !now->enabled || now->period_us == 0) break;
+      if (now->pulse_us > 0) {
+        const auto rise = static_cast<std::int64_t>(start_us) * 1000;
+        out.push_back({rise, WaveSignal::kServo, 1});
+        out.push_back({rise + std::int64_t{now->pulse_us} * 1000, WaveSignal::kServo, 0});
+      }
+      start_us += now->period_us;
+    }
+  }
+  return out;
+}
+
+std::vector<Transition> TransitionsFromServoEvents(const WaveformHeader& header,
+                                                   const std::vector<hal::StepDirEvent>& steps,
+                                                   const std::vector<hal::PwmEvent>& pwm,
+                                                   const WaveformWriteOptions& options,
+                                                   std::uint64_t end_us) {
+  if (header.pen != PenKind::kServo) {
+    throw std::invalid_argument("a servo pen's waveform needs a '# pen servo' header");
+  }
+  std::vector<Transition> out;
+  AppendStepDir(header, steps, options, &out);
+  const std::vector<Transition> servo = ServoTransitionsFromPwm(pwm, end_us);
+  out.insert(out.end(), servo.begin(), servo.end());
+  SortByTime(&out);
   return out;
 }
 

@@ -94,16 +94,25 @@ def check_pins(workdir):
         ("a header with other widths", False, servo_waveform(good, pen="servo 900 2100")),
         ("an ENABLE that starts active", False, servo_waveform(good, enable_start=0)),
     ]
-    for what, passes, text in cases:
-        path = os.path.join(workdir, "case.wave")
-        with open(path, "w") as f:
-            f.write(text)
+    # The CONFIG's widths 1200/1800: the image's 1000 (pen up) only before them.
+    job = [1000] * 2 + [1200] * 3 + [1800] * 5 + [1200] * 3
+    job_cases = [
+        ("the CONFIG's 1200/1800 us after the image's pen-up 1000", True, servo_waveform(job)),
+        ("the image's 2000 us after the CONFIG", False, servo_waveform(job[:7] + [2000] + job[8:])),
+        ("the image's 1000 us after the CONFIG", False, servo_waveform(job[:4] + [1000] + job[5:])),
+        ("the image's widths only (the CONFIG ignored)", False, servo_waveform(good)),
+    ]
+    for job_us, case_list in ((None, cases), ((1200, 1800), job_cases)):
+        for what, passes, text in case_list:
+            path = os.path.join(workdir, "case.wave")
+            with open(path, "w") as f:
+                f.write(text)
 
-        def check(p=path):
-            header, transitions = run_e2e.read_transitions(p)
-            run_e2e.check_enable_released(header, transitions)
-            run_e2e.check_servo(header, transitions, (1000, 2000))
-        expect(what, passes, check)
+            def check(p=path, j=job_us):
+                header, transitions = run_e2e.read_transitions(p)
+                run_e2e.check_enable_released(header, transitions)
+                run_e2e.check_servo(header, transitions, (1000, 2000), j)
+            expect(what, passes, check)
 
 
 def main():

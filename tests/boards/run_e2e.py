@@ -108,14 +108,18 @@ MICROBIT_LIMITS = [
 
 # Per board: the baud of its UART, the step timing its drivers need (RAMPS:
 # DRV8825, 1.9 us pulse and 650 ns DIR set-up; A4988 elsewhere: 1 us, 200 ns),
-# the pen servo's profile widths (us, up and down; None: a pen line), the
+# the pen servo's widths built into the image (us, up and down; None: a pen
+# line) and the widths the job's CONFIG gives it (--servo-pulse-up/-down in
+# the job's options; None: the image's), the
 # limits on its measures (None: its harness writes none), and the short CI
 # job's options (about 6 s of machine time, the speed at most one step per
 # tick of the board; the tick rate itself comes from the board's HELLO).
 BOARDS = {
     "mega2560-ramps": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
-                       "servo_us": (1000, 2000), "limits": MEGA_LIMITS,
-                       "job_args": "--fit 20x15 --lines 2 --speed 20"},
+                       "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
+                       "limits": MEGA_LIMITS,
+                       "job_args": "--fit 20x15 --lines 2 --speed 20 "
+                                   "--servo-pulse-up 1200 --servo-pulse-down 1800"},
     "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
                     "servo_us": None, "limits": MICROBIT_LIMITS,
                     "job_args": "--fit 40x30 --lines 2"},
@@ -383,14 +387,18 @@ def check_enable_released(header, transitions):
     return "%s released at reset" % " ".join(sorted(first))
 
 
-def check_servo(header, transitions, servo_us):
-    """A servo pen: the header names the profile's widths, every pulse is
-    exactly one of them, pulses start one period apart, and both were seen
-    (the pen went down and up)."""
+def check_servo(header, transitions, servo_us, job_us=None):
+    """A servo pen: the header names the image's widths `servo_us`; every
+    pulse is exactly one of the job's widths (`job_us`, the CONFIG's; None:
+    the image's), except the image's pen-up pulses before the first of them
+    (the board starts before the CONFIG arrives); pulses start one period
+    apart, and both job widths were seen (the pen went down and up)."""
     declared = header_value(header, "pen")
     if declared != ["servo"] + [str(us) for us in servo_us]:
-        raise Failure("the recording's header says '# pen %s', the profile 'servo %d %d'" %
+        raise Failure("the recording's header says '# pen %s', the image's 'servo %d %d'" %
                       (" ".join(declared or []), servo_us[0], servo_us[1]))
+    image_up_us = servo_us[0]
+    servo_us = job_us or servo_us
     seen, rise, last_rise = set(), None, None
     for time_ns, name, level in transitions:
         if name != "SERVO":
@@ -403,12 +411,14 @@ def check_servo(header, transitions, servo_us):
             rise = last_rise = time_ns
         elif rise is not None:
             width_us = (time_ns - rise) / 1000
+            rise = None
+            if not seen and abs(width_us - image_up_us) <= SERVO_WIDTH_SLACK_US:
+                continue  # before the CONFIG took effect
             nearest = min(servo_us, key=lambda us: abs(us - width_us))
             if abs(width_us - nearest) > SERVO_WIDTH_SLACK_US:
                 raise Failure("a servo pulse of %.1f us at %d ns: not up/down %s us" %
-                              (width_us, rise, servo_us))
+                              (width_us, last_rise, servo_us))
             seen.add(nearest)
-            rise = None
     if seen != set(servo_us):
         raise Failure("servo pulses of %s us only, expected both %s" % (sorted(seen), servo_us))
     return "servo pulses %d/%d us every 20 ms" % servo_us
@@ -419,7 +429,8 @@ def check_board(args, board, rec, measures_path, hello_tick_hz):
     header, transitions = read_transitions(rec)
     report = [check_enable_released(header, transitions)]
     if board["servo_us"]:
-        report.append(check_servo(header, transitions, board["servo_us"]))
+        report.append(check_servo(header, transitions, board["servo_us"],
+                                  board.get("job_servo_us")))
     if board["limits"] is not None:
         report += check_measures(read_measures(measures_path), board["limits"], args.scenario,
                                  hello_tick_hz, measures_path)

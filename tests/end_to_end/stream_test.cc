@@ -14,6 +14,7 @@
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/motion/path_generator.h"
+#include "fdsurf/protocol/codec.h"
 #include "fdsurf/sim/checks.h"
 #include "fdsurf/sim/plotter.h"
 
@@ -188,6 +189,37 @@ TEST(BuildStreamJob, RefusesATravelTheDeviceCannotMove) {
   }
   const host::StreamJob job = host::BuildStreamJob(far, options, machine, "mm");
   EXPECT_LE(job.config.travel_steps[0], motion::kMaxPlannableTravelSteps);
+}
+
+// The servo pen's widths go into CONFIG as given; both 0 or each in
+// 500..2500 µs, else refused naming the option.
+TEST(BuildStreamJob, ServoPulsesGoIntoTheConfigOrAreRefused) {
+  host::ToolpathOptions options;
+  options.view = *host::NamedView("iso");
+  options.fit = std::array<double, 2>{24, 18};
+  options.lines_s = 2;
+  options.lines_t = 2;
+  host::MachineOptions machine;
+  EXPECT_EQ(host::BuildStreamJob(Teapot(), options, machine, "mm").config.servo_up_us, 0);
+  machine.servo_up_us = 1300;
+  machine.servo_down_us = 1700;
+  const host::StreamJob job = host::BuildStreamJob(Teapot(), options, machine, "mm");
+  EXPECT_EQ(job.config.servo_up_us, 1300);
+  EXPECT_EQ(job.config.servo_down_us, 1700);
+  EXPECT_TRUE(protocol::ValidateFields(job.commands.front()).ok());
+  const auto refusal = [&](int up, int down) {
+    machine.servo_up_us = up;
+    machine.servo_down_us = down;
+    try {
+      (void)host::BuildStreamJob(Teapot(), options, machine, "mm");
+    } catch (const host::OptionError& error) {
+      return error.field() + ": " + error.problem();
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refusal(0, 1500), "servo pulse up: is 0 while the other is not (both 0: a switch pen)");
+  EXPECT_EQ(refusal(1500, 2501), "servo pulse down: is outside 500..2500 (a servo's pulse widths)");
+  EXPECT_EQ(refusal(499, 1500), "servo pulse up: is outside 500..2500 (a servo's pulse widths)");
 }
 
 // Issue 12, defect 2: the simulator's time stood still while the device

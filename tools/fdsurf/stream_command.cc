@@ -57,6 +57,8 @@ MachineOptions Machine(const StreamOptions& o) {
   m.accel = o.accel_limit ? *o.accel_limit : DefaultIn(m.accel, o.units);
   if (!(m.speed > 0) || !(m.accel > 0)) throw InputError("--speed and --accel must be above 0");
   m.pen_delay_ms = o.pen_delay_ms;
+  m.servo_up_us = o.servo_pulse_up_us;
+  m.servo_down_us = o.servo_pulse_down_us;
   return m;
 }
 
@@ -192,6 +194,17 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->capture_default_str();
   AddMachineOptions(command, o);
   command->add_option("--pen-delay", o->pen_delay_ms, "rest after each pen change, milliseconds")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  command
+      ->add_option("--servo-pulse-up", o->servo_pulse_up_us,
+                   "servo pen lift: pulse width with the pen up, µs (500..2500; both 0: the pen "
+                   "is a switch)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  command
+      ->add_option("--servo-pulse-down", o->servo_pulse_down_us,
+                   "servo pen lift: pulse width with the pen down, µs (500..2500)")
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
   command->add_option("--tick-hz", o->tick_hz,

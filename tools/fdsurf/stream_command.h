@@ -47,6 +47,9 @@ struct StreamOptions {
   double speed = 0;
   double accel = 0;
   int pen_delay_ms = 100;
+  /// The servo pen lift's pulse widths, µs; both 0: a switch pen.
+  int servo_pulse_up_us = 0;
+  int servo_pulse_down_us = 0;
   std::uint32_t tick_hz = 0;
   // The link and the simulator.
   std::uint64_t link_bytes_per_second = 1'000'000;

@@ -86,7 +86,10 @@ class RampsSteppers final : public hal::StepDirOutputs {
 /// A new width takes effect at the start of the next 20 ms period, from
 /// Timer1's overflow interrupt (OnPeriodStart): the hardware buffers OCR1A
 /// in this mode anyway, simavr does not, and a width changed mid-pulse must
-/// not make one 21 ms pulse.
+/// not make one 21 ms pulse. The widths are the image's (kServoUpUs,
+/// kServoDownUs) until a CONFIG gives others (servo_up_us/servo_down_us,
+/// 500..2500 µs, checked by the codec); a CONFIG with both 0 returns to the
+/// image's.
 class ServoPen final : public hal::PenOutput {
  public:
   ServoPen() = default;
@@ -104,14 +107,26 @@ class ServoPen final : public hal::PenOutput {
  private:
   // Runs in the step interrupt, so the overflow interrupt cannot cut in.
   hal::IoStatus DoSetPen(bool down) override {
-    next_compare_ = CompareFor(down ? kServoDownUs : kServoUpUs);
+    down_ = down;
+    next_compare_ = CompareFor(down ? down_us_ : up_us_);
     TIFR1 = _BV(TOV1);  // an overflow flagged before now is not this period's start
     TIMSK1 |= _BV(TOIE1);
     return hal::IoStatus::kOk;
   }
+  // Also from the step interrupt (Device::Tick), before any pen change; the
+  // pen moves to the new width of the state it is in.
+  hal::IoStatus DoConfigureServo(uint16_t up_us, uint16_t down_us) override {
+    const bool image_widths = up_us == 0 && down_us == 0;
+    up_us_ = image_widths ? kServoUpUs : up_us;
+    down_us_ = image_widths ? kServoDownUs : down_us;
+    return DoSetPen(down_);
+  }
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
 
   volatile uint16_t next_compare_ = CompareFor(kServoUpUs);
+  uint16_t up_us_ = kServoUpUs;
+  uint16_t down_us_ = kServoDownUs;
+  bool down_ = false;
 };
 
 }  // namespace mega

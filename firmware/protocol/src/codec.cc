@@ -68,6 +68,8 @@ void WriteCommandBody(const Command& command, Writer* w) {
       w->PutU32(c.max_rate);
       w->PutU32(c.accel);
       w->PutU16(c.pen_delay_ms);
+      w->PutU16(c.servo_up_us);
+      w->PutU16(c.servo_down_us);
       break;
     }
     case MessageType::kPatch: {
@@ -221,6 +223,18 @@ bool BasisValid(uint8_t basis) { return basis < kBasisCount; }
 bool DimsValid(uint8_t dims) { return dims >= 2 && dims <= kMaxAxes; }
 bool LinesValid(uint16_t lines) { return lines == 0 || (lines >= 2 && lines <= kMaxLines); }
 
+// Both 0 (a plain switch pen) or each a servo pulse width: one encoding of
+// "no servo", and no width a servo could be driven to the end stop by.
+bool ServoPulseValid(uint16_t us) { return us >= 500 && us <= 2500; }
+
+void ReadServo(Reader* r, MachineConfig* c) {
+  c->servo_up_us = r->U16(kConfigFieldServoUp);
+  c->servo_down_us = r->U16(kConfigFieldServoDown);
+  const bool switch_pen = c->servo_up_us == 0 && c->servo_down_us == 0;
+  r->Check(switch_pen || ServoPulseValid(c->servo_up_us), kConfigFieldServoUp);
+  r->Check(switch_pen || ServoPulseValid(c->servo_down_us), kConfigFieldServoDown);
+}
+
 void ReadConfig(Reader* r, MachineConfig* c) {
   c->axes = r->U8(kConfigFieldAxes);
   r->Check(c->axes >= 2 && c->axes <= kMaxAxes, kConfigFieldAxes);
@@ -243,6 +257,7 @@ void ReadConfig(Reader* r, MachineConfig* c) {
   c->accel = r->U32(kConfigFieldAccel);
   r->Check(c->accel >= 1, kConfigFieldAccel);
   c->pen_delay_ms = r->U16(kConfigFieldPenDelay);
+  ReadServo(r, c);
   r->End(kConfigFieldCount);
 }
 

@@ -55,7 +55,7 @@ Command Config() {
   Command c;
   c.type = MessageType::kConfig;
   c.seq = 0;
-  c.body.config = MachineConfig{2, {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150};
+  c.body.config = MachineConfig{2, {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150, 0, 0};
   return c;
 }
 
@@ -141,6 +141,14 @@ TEST(Codec, CommandRoundTrips) {
   config3.body.config.steps_per_meter[2] = 400000;
   config3.body.config.travel_steps[2] = kMaxTravelSteps;
   ExpectRoundTrip(config3);
+  Command servo = Config();
+  servo.body.config.servo_up_us = 1200;
+  servo.body.config.servo_down_us = 1850;
+  ExpectRoundTrip(servo);
+  // The widths on the wire, after pen_delay_ms: u16 little-endian each.
+  const Bytes servo_body = CommandBody(servo);
+  ASSERT_GE(servo_body.size(), 4u);
+  EXPECT_EQ(Bytes(servo_body.end() - 4, servo_body.end()), (Bytes{0xB0, 0x04, 0x3A, 0x07}));
   for (uint64_t salt = 0; salt < 50; ++salt) {
     ExpectRoundTrip(Patch(2, salt));
     ExpectRoundTrip(Patch(3, salt));
@@ -230,6 +238,19 @@ TEST(CodecValidation, Config) {
                 bad, 6);  // Z used, travel 0
   ExpectRefused(with([](MachineConfig* m) { m->max_rate = 0; }), bad, kConfigFieldMaxRate);
   ExpectRefused(with([](MachineConfig* m) { m->accel = 0; }), bad, kConfigFieldAccel);
+  // The servo pen: both 0 (a switch) or each in 500..2500.
+  const auto servo = [&](uint16_t up, uint16_t down) {
+    return with([=](MachineConfig* m) {
+      m->servo_up_us = up;
+      m->servo_down_us = down;
+    });
+  };
+  EXPECT_TRUE(ValidateFields(servo(500, 2500)).ok());
+  EXPECT_TRUE(ValidateFields(servo(2500, 500)).ok());
+  ExpectRefused(servo(499, 2000), bad, kConfigFieldServoUp);
+  ExpectRefused(servo(1000, 2501), bad, kConfigFieldServoDown);
+  ExpectRefused(servo(0, 2000), bad, kConfigFieldServoUp);    // one 0 is not a switch
+  ExpectRefused(servo(1000, 0), bad, kConfigFieldServoDown);  // nor the other
 }
 
 TEST(CodecValidation, Patch) {
@@ -322,9 +343,13 @@ TEST(CodecValidation, ExactLength) {
   const Bytes pen = {1, 0};
   EXPECT_EQ(DecodeCommand(BodyFrame(MessageType::kPen, pen), &out).field, kPenFieldCount);
   Bytes config_short = CommandBody(Config());
-  ASSERT_EQ(config_short.size(), 35u);
-  config_short.pop_back();  // pen_delay_ms cut short
-  const DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
+  ASSERT_EQ(config_short.size(), 39u);
+  config_short.pop_back();  // servo_down_us cut short
+  DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
+  EXPECT_EQ(r.code, ErrorCode::kBadLength);
+  EXPECT_EQ(r.field, kConfigFieldServoDown);
+  config_short.resize(35 - 1);  // pen_delay_ms cut short
+  r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
   EXPECT_EQ(r.field, kConfigFieldPenDelay);
   const Bytes patch_cut = {2, 2, 2, 0, 0, 0, 1, 0, 0, 0, 0, 5};  // one of 32 geometry values

@@ -77,8 +77,28 @@ std::int32_t TravelSteps(double length, const Quantum& step, const std::string& 
   return static_cast<std::int32_t>(steps);
 }
 
+// The servo pen's widths: both 0 (a switch pen) or each a pulse a hobby
+// servo takes, 500..2500 µs (the protocol's range).
+void SetServoPulses(const MachineOptions& machine, protocol::MachineConfig* config) {
+  const bool switch_pen = machine.servo_up_us == 0 && machine.servo_down_us == 0;
+  const struct {
+    const char* field;
+    int us;
+  } pulses[] = {{"servo pulse up", machine.servo_up_us},
+                {"servo pulse down", machine.servo_down_us}};
+  for (const auto& pulse : pulses) {
+    if (!switch_pen && (pulse.us < 500 || pulse.us > 2500)) {
+      throw OptionError(pulse.field, std::to_string(pulse.us) + " µs",
+                        pulse.us == 0 ? "is 0 while the other is not (both 0: a switch pen)"
+                                      : "is outside 500..2500 (a servo's pulse widths)");
+    }
+  }
+  config->servo_up_us = static_cast<std::uint16_t>(machine.servo_up_us);
+  config->servo_down_us = static_cast<std::uint16_t>(machine.servo_down_us);
+}
+
 // The machine configuration: travel (the page's unless given), steps per
-// meter, speed and acceleration in steps, the pen delay.
+// meter, speed and acceleration in steps, the pen delay and servo widths.
 protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath& page,
                                   const std::string& units) {
   protocol::MachineConfig config{};
@@ -117,6 +137,7 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   config.max_rate = static_cast<std::uint32_t>(max_rate);
   config.accel = static_cast<std::uint32_t>(accel);
   config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
+  SetServoPulses(machine, &config);
   return config;
 }
 

@@ -32,9 +32,6 @@ constexpr PlannedKey kPlannedKeys[] = {
     {"accel_x", "acceleration per axis is not supported yet: give 'accel', the path's"},
     {"accel_y", "acceleration per axis is not supported yet: give 'accel', the path's"},
     {"accel_z", "acceleration per axis is not supported yet: give 'accel', the path's"},
-    {"servo_pulse_up", "servo pulse widths are not supported yet: give servo_up/servo_down angles"},
-    {"servo_pulse_down",
-     "servo pulse widths are not supported yet: give servo_up/servo_down angles"},
     {"origin", "the machine's origin is not supported yet (stream --origin places the page)"},
 };
 
@@ -170,6 +167,10 @@ const std::vector<MachineKey>& MachineKeys() {
       {"accel", T::kLength, "units/s²", "--accel", C::kPositive, "stream: path acceleration limit"},
       {"pen_delay", T::kInteger, "ms", "--pen-delay", C::kNone,
        "stream: rest after each pen change"},
+      {"servo_pulse_up", T::kInteger, "µs", "--servo-pulse-up", C::kNone,
+       "stream: servo pen lift's pulse width with the pen up (0: the pen is a switch)"},
+      {"servo_pulse_down", T::kInteger, "µs", "--servo-pulse-down", C::kNone,
+       "stream: servo pen lift's pulse width with the pen down (0: the pen is a switch)"},
       {"tick_hz", T::kInteger, "Hz", "--tick-hz", C::kNone,
        "stream: the device's step timer (sim: must divide 1000000)"},
       {"flavor", T::kText, "", "--flavor", C::kNone,

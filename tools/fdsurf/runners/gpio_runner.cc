@@ -9,6 +9,8 @@
 #include "fdsurf/device/device.h"
 #include "fdsurf/hal/gpiod_outputs.h"
 #include "fdsurf/hal/monotonic_clock.h"
+#include "fdsurf/hal/pwm.h"
+#include "fdsurf/hal/sysfs_pwm.h"
 #include "fdsurf/hal/tick_scheduler.h"
 #include "runner.h"
 #include "tick_loop.h"
@@ -16,19 +18,64 @@
 namespace fdsurf::host {
 namespace {
 
-// Everything a job on the GPIO lines runs with, apart from the Device.
+// A servo pen on a PWM channel of the kernel (the PEN field pwmN.M of
+// --device): started with the job's CONFIG widths, lifted on every exit path
+// (the destructor waits two 20 ms periods for the up pulse to go out).
+class PwmServoPen {
+ public:
+  PwmServoPen(const hal::GpiodConfig& config, const protocol::MachineConfig& machine) {
+    if (machine.servo_up_us == 0) {
+      throw InputError("--device: the pen is a servo on pwm" + std::to_string(config.pen_pwm_chip) +
+                       "." + std::to_string(config.pen_pwm_channel) +
+                       ": give its pulse widths (--servo-pulse-up, --servo-pulse-down)");
+    }
+    hal::SysfsPwmConfig pwm_config;
+    pwm_config.chip = config.pen_pwm_chip;
+    pwm_config.channel = config.pen_pwm_channel;
+    std::string error;
+    if (hal::SysfsPwm::Open(pwm_config, &pwm_, &error) != hal::IoStatus::kOk) {
+      throw DeviceError(error);
+    }
+    pen_ = std::make_unique<hal::ServoPen>(*pwm_, machine.servo_up_us, machine.servo_down_us);
+    if (pen_->Start() != hal::IoStatus::kOk) throw DeviceError(pen_->LastError());
+  }
+  ~PwmServoPen() {
+    if (static_cast<hal::PenOutput&>(*pen_).SetPen(false) != hal::IoStatus::kOk) return;
+    hal::MonotonicClock clock;
+    clock.SleepUntilMicros(clock.NowMicros() + 2 * hal::kServoPeriodUs);
+  }
+  PwmServoPen(const PwmServoPen&) = delete;
+  PwmServoPen& operator=(const PwmServoPen&) = delete;
+
+  hal::PenOutput& pen() { return *pen_; }
+
+ private:
+  std::unique_ptr<hal::SysfsPwm> pwm_;
+  std::unique_ptr<hal::ServoPen> pen_;
+};
+
+// Everything a job on the GPIO lines runs with, apart from the Device. The
+// pen is the pen line of `lines`, or a servo on a PWM channel.
 struct GpioRig {
-  GpioRig(hal::GpiodOutputs& lines, std::uint32_t tick_hz, bool quiet)
+  GpioRig(hal::GpiodOutputs& lines, hal::PenOutput& pen_output, std::uint32_t tick_hz, bool quiet)
       // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
       : ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz),
         link(LinkOptions()),
         outputs(lines),
+        pen(pen_output),
         progress(ShowProgress(quiet)) {}
+
+  // The failed output's detail: the lines', else the pen's.
+  FDSURF_NODISCARD std::string OutputError() const {
+    const std::string lines_error = outputs.StepDirOutputs::LastError();
+    return "gpio: " + (lines_error.empty() ? std::string(pen.LastError()) : lines_error);
+  }
 
   hal::MonotonicClock clock;
   hal::TickScheduler ticks;
   HostLink link;
   hal::GpiodOutputs& outputs;
+  hal::PenOutput& pen;
   ProgressLine progress;
 };
 
@@ -41,9 +88,9 @@ void Tick(GpioRig& rig, Device& device, std::uint64_t total_commands, KeepGoing 
     last_progress = now;
     rig.progress.Show(device.executed(), total_commands, rig.link.stats().frames_sent, 0);
   };
-  if (RunTickLoopWhile(rig.clock, rig.ticks, rig.link, device, rig.outputs, rig.outputs,
-                       show_progress, keep_going) != hal::IoStatus::kOk) {
-    throw DeviceError(std::string("gpio: ") + rig.outputs.StepDirOutputs::LastError());
+  if (RunTickLoopWhile(rig.clock, rig.ticks, rig.link, device, rig.outputs, rig.pen, show_progress,
+                       keep_going) != hal::IoStatus::kOk) {
+    throw DeviceError(rig.OutputError());
   }
 }
 
@@ -115,9 +162,9 @@ int RunLayers(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device
     }
     rig.progress.Finish();
     const auto idle_slice = [&] {
-      if (RunIdleTicks(rig.clock, rig.ticks, link, device, rig.outputs, rig.outputs,
+      if (RunIdleTicks(rig.clock, rig.ticks, link, device, rig.outputs, rig.pen,
                        std::max<std::uint64_t>(1, tick_hz / 50)) != hal::IoStatus::kOk) {
-        throw DeviceError(std::string("gpio: ") + rig.outputs.StepDirOutputs::LastError());
+        throw DeviceError(rig.OutputError());
       }
     };
     if (!PauseForLayer(o.no_pause, job, to, device.executed(), idle_slice)) {
@@ -152,8 +199,10 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   if (hal::GpiodOutputs::Open(config, &outputs, &error) != hal::IoStatus::kOk) {
     throw DeviceError(error);
   }
+  std::unique_ptr<PwmServoPen> servo;
+  if (!config.has_pen_line) servo = std::make_unique<PwmServoPen>(config, job.config);
   const InterruptGuard interrupts;
-  GpioRig rig(*outputs, tick_hz, o.quiet);
+  GpioRig rig(*outputs, servo ? servo->pen() : *outputs, tick_hz, o.quiet);
   rig.progress.SetSchedule(o.schedule.get());
   int code = 0;
   if (o.dims == 3) {

@@ -83,6 +83,22 @@ class PenOutput {
   ///   kIoError  the line could not be set (LastError() has the detail).
   IoStatus SetPen(bool down) { return DoSetPen(down); }
 
+  /// The pen's configuration from the machine's CONFIG (protocol fields
+  /// servo_up_us, servo_down_us): a hobby-servo pen (hal/pwm.h ServoPen)
+  /// pulses `up_us` with the pen up and `down_us` with it down, µs, and
+  /// moves to the new width of the state it is in; both 0 means "a plain
+  /// switch" (a servo pen returns to its board's default widths). A plain
+  /// switch pen (a GPIO line) has nothing to configure and accepts any
+  /// widths: the optional hook's default does nothing.
+  ///
+  /// Errors:
+  ///   kInvalidArgument  a servo pen: the widths are not both 0 and one is
+  ///                     outside 500..2500; nothing changed.
+  ///   kIoError          the servo's PWM could not be set.
+  IoStatus ConfigureServo(uint16_t up_us, uint16_t down_us) {
+    return DoConfigureServo(up_us, down_us);
+  }
+
   /// The detail of the last failed call ("" if none).
   FDSURF_NODISCARD const char* LastError() const { return DoLastError(); }
 
@@ -92,6 +108,9 @@ class PenOutput {
 
  private:
   virtual IoStatus DoSetPen(bool down) = 0;
+  virtual IoStatus DoConfigureServo(uint16_t /*up_us*/, uint16_t /*down_us*/) {
+    return IoStatus::kOk;
+  }
   FDSURF_NODISCARD virtual const char* DoLastError() const = 0;
 };
 

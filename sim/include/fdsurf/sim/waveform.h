@@ -120,6 +120,23 @@ std::vector<Transition> TransitionsFromEvents(const WaveformHeader& header,
                                               const std::vector<hal::PenEvent>& pens,
                                               const WaveformWriteOptions& options);
 
+/// The SERVO pin of a hal::SimPwm (a hal::ServoPen's channel) from its
+/// recorded events, up to `end_us`: the initial level 0, then a pulse at the
+/// start of every period while enabled. Periods start at the enable and
+/// follow each other; each pulses the width in force at its start, so a new
+/// width shows from the next period on, as a timer's buffered compare does.
+std::vector<Transition> ServoTransitionsFromPwm(const std::vector<hal::PwmEvent>& pwm,
+                                                std::uint64_t end_us);
+
+/// As TransitionsFromEvents, for a servo pen on a hal::SimPwm: the SERVO pin
+/// (ServoTransitionsFromPwm) in place of a PEN line. header.pen must be
+/// kServo, else std::invalid_argument.
+std::vector<Transition> TransitionsFromServoEvents(const WaveformHeader& header,
+                                                   const std::vector<hal::StepDirEvent>& steps,
+                                                   const std::vector<hal::PwmEvent>& pwm,
+                                                   const WaveformWriteOptions& options,
+                                                   std::uint64_t end_us);
+
 /// Writes the header and the transitions in the format above.
 void WriteWaveform(std::ostream& out, const WaveformHeader& header,
                    const std::vector<Transition>& transitions);

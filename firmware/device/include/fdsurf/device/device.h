@@ -150,15 +150,21 @@ class Device {
     // After a fault the motion still comes to rest along its path and the
     // pen is lifted, unless the outputs themselves failed.
     if (outputs_failed_ || (fault_ && motion_.Idle())) return hal::IoStatus::kOk;
+    if (pen_config_pending_) {
+      // A CONFIG took effect (the motion at rest): the pen's servo widths.
+      pen_config_pending_ = false;
+      const hal::IoStatus configured = pen.ConfigureServo(pen_servo_up_us_, pen_servo_down_us_);
+      if (configured != hal::IoStatus::kOk) return OutputFailed(configured);
+    }
     if (halt_outputs_ || pause_ != PausePhase::kNone) {
       bool consumed = false;
       const hal::IoStatus status = TickPauseOrHalt(steppers, pen, &consumed);
       if (status != hal::IoStatus::kOk) return OutputFailed(status);
       if (consumed) return status;
     }
+    hal::IoStatus status = hal::IoStatus::kOk;
     const motion::TickOutput out = motion_.Tick();
     executed_ += out.commands_done;
-    hal::IoStatus status = hal::IoStatus::kOk;
     if (out.pen != 0) status = pen.SetPen(out.pen > 0);
     if (status == hal::IoStatus::kOk && out.step_mask != 0) {
       if (!enabled_) {
@@ -341,6 +347,9 @@ class Device {
     outputs_failed_ = false;
     enabled_ = false;
     directions_ = 0;
+    pen_config_pending_ = false;
+    pen_servo_up_us_ = 0;
+    pen_servo_down_us_ = 0;
     error_ = protocol::ErrorCode::kNone;
     error_detail_ = 0;
     generator_.Reset(motion_.position(), false);
@@ -358,6 +367,10 @@ class Device {
     const InterruptLock lock;
     if (!motion_.Idle()) return false;
     if (converted) motion_.Configure(tick);
+    // Handed to the pen output by the next Tick(), before any pen change.
+    pen_servo_up_us_ = config.servo_up_us;
+    pen_servo_down_us_ = config.servo_down_us;
+    pen_config_pending_ = true;
     ++executed_;
     return true;
   }
@@ -493,6 +506,10 @@ class Device {
   bool outputs_failed_;
   bool enabled_;
   uint8_t directions_;
+  // The pen's CONFIG (servo widths, µs) waiting for Tick() to hand it over.
+  bool pen_config_pending_;
+  uint16_t pen_servo_up_us_;
+  uint16_t pen_servo_down_us_;
   protocol::ErrorCode error_;
   uint8_t error_detail_;
   uint32_t executed_;

@@ -20,7 +20,8 @@ namespace protocol {
 
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
 /// the session id (Hello::session), folded into the CRC of every other frame.
-/// Version 3 adds PAUSE, RESUME and HALT (and the other rows of issue 15).
+/// Version 3 adds PAUSE, RESUME and HALT, and the machine's pen hardware and
+/// limits in CONFIG (issue 15).
 constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
@@ -95,6 +96,11 @@ struct MachineConfig {
   uint32_t accel;
   /// Rest after every pen change before motion resumes, milliseconds.
   uint16_t pen_delay_ms;
+  /// A hobby-servo pen lift's pulse widths, µs, every 20 ms: with the pen up
+  /// and with it down. Both 0: the pen output is a plain switch; else each
+  /// in 500..2500 (hal/pwm.h ServoPen).
+  uint16_t servo_up_us;
+  uint16_t servo_down_us;
 };
 
 /// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a

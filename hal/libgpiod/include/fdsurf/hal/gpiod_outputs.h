@@ -9,6 +9,10 @@
 //   LINES  STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN: 6 line offsets for two
 //          axes, 8 for three. EN may be `-` (no enable line).
 //
+// PEN may instead be `pwmN.M`: the pen is a hobby servo on channel M of the
+// kernel's PWM chip N (/sys/class/pwm/pwmchipN/pwmM, hal/linux sysfs_pwm.h),
+// driven by the caller (no pen line is requested here).
+//
 // Each offset may carry a polarity prefix: `!` active-low, `+` active-high.
 // Defaults: STEP, DIR and PEN active-high, EN active-low (the ~ENABLE input
 // of A4988 and DRV8825 boards). "Active" means: STEP pulsing, DIR moving
@@ -17,6 +21,7 @@
 //   gpio:gpiochip0:17,27,22,23,24,25          X 17/27, Y 22/23, ~EN 24, pen 25
 //   gpio:gpiochip0:17,!27,22,23,5,6,+24,25    X dir inverted, Z 5/6, EN active-high
 //   gpio:/dev/gpiochip0:17,27,22,23,-,!25     no enable line, pen line active-low
+//   gpio:gpiochip0:17,27,22,23,24,pwm0.1      pen servo on pwmchip0's channel 1
 #pragma once
 
 #include <stdint.h>
@@ -53,6 +58,12 @@ struct GpiodConfig {
   bool has_enable = false;
   GpioLine enable{0, true};
   GpioLine pen;
+  /// false when PEN was `pwmN.M`: the pen is a servo on that PWM channel,
+  /// which the caller drives; no pen line is requested and SetPen() here
+  /// does nothing.
+  bool has_pen_line = true;
+  unsigned pen_pwm_chip = 0;
+  unsigned pen_pwm_channel = 0;
   /// The shortest STEP pulse, in microseconds, busy-waited on CLOCK_MONOTONIC:
   /// both the high time and the low time before the next pulse. A4988 needs
   /// 1 µs, DRV8825 1.9 µs.

@@ -16,6 +16,7 @@
 #include "fdsurf/hal/clock.h"
 #include "fdsurf/hal/io_status.h"
 #include "fdsurf/hal/outputs.h"
+#include "fdsurf/hal/pwm.h"
 #include "fdsurf/hal/transport.h"
 
 namespace fdsurf {
@@ -116,6 +117,54 @@ class SimPen final : public PenOutput {
   SimClock& clock_;
   std::vector<PenEvent> events_;
   bool down_ = false;
+  IoStatus injected_ = IoStatus::kOk;
+  std::string last_error_;
+};
+
+/// One recorded change of a PWM channel: the settings in force from
+/// `time_us` on (a pulse of pulse_us at the start of every period_us while
+/// enabled).
+struct PwmEvent {
+  uint64_t time_us;
+  uint32_t period_us;
+  uint32_t pulse_us;
+  bool enabled;
+  bool operator==(const PwmEvent&) const = default;
+};
+
+/// A PWM channel that records every change of its settings (a call that
+/// changes nothing records nothing) with the virtual time. Starts disabled,
+/// period and pulse 0. Refuses (kInvalidArgument) a period of 0 or above
+/// `max_period_us`, or a pulse longer than the period, like a timer would.
+class SimPwm final : public PwmOutput {
+ public:
+  /// The clock must outlive this object.
+  explicit SimPwm(SimClock& clock, uint32_t max_period_us = 1000000)
+      : clock_(clock), max_period_us_(max_period_us) {}
+
+  FDSURF_NODISCARD const std::vector<PwmEvent>& events() const { return events_; }
+  void ClearEvents() { events_.clear(); }
+  FDSURF_NODISCARD uint32_t period_us() const { return period_us_; }
+  FDSURF_NODISCARD uint32_t pulse_us() const { return pulse_us_; }
+  FDSURF_NODISCARD bool enabled() const { return enabled_; }
+  /// Makes the next call fail with `status`; LastError() then reads
+  /// "sim pwm: injected <status name>".
+  void InjectError(IoStatus status) { injected_ = status; }
+
+ private:
+  IoStatus DoSetPeriodMicros(uint32_t period_us) override;
+  IoStatus DoSetPulseMicros(uint32_t pulse_us) override;
+  IoStatus DoSetEnabled(bool enabled) override;
+  FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
+  IoStatus Injected();
+  void Record(uint32_t period_us, uint32_t pulse_us, bool enabled);
+
+  SimClock& clock_;
+  uint32_t max_period_us_;
+  std::vector<PwmEvent> events_;
+  uint32_t period_us_ = 0;
+  uint32_t pulse_us_ = 0;
+  bool enabled_ = false;
   IoStatus injected_ = IoStatus::kOk;
   std::string last_error_;
 };

@@ -33,6 +33,11 @@ struct MachineOptions {
   double speed = 100;
   double accel = 2000;
   int pen_delay_ms = 100;
+  /// A hobby-servo pen lift's pulse widths, µs (the device's CONFIG
+  /// servo_up_us/servo_down_us): both 0 for a plain switch pen, else each
+  /// in 500..2500.
+  int servo_up_us = 0;
+  int servo_down_us = 0;
 };
 
 /// One patch as the device will draw it, for checks: the patch, and the
