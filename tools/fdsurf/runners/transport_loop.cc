@@ -28,6 +28,8 @@ const char* StateName(protocol::DeviceState state) {
       return "stopping";
     case protocol::DeviceState::kFault:
       return "fault";
+    case protocol::DeviceState::kHoming:
+      return "homing";
   }
   return "unknown";
 }

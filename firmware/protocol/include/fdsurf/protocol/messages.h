@@ -19,8 +19,10 @@ namespace fdsurf {
 namespace protocol {
 
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
-/// the session id (Hello::session), folded into the CRC of every other frame.
-constexpr uint8_t kProtocolVersion = 2;
+/// the session id (Hello::session), folded into the CRC of every other frame;
+/// version 3 adds homing (HOME, MOTORS, MachineConfig::flags, the status
+/// flags and HELLO_REPLY's features) among others (docs/protocol.md).
+constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -39,6 +41,8 @@ enum class MessageType : uint8_t {
   kCurve = 0x12,   ///< CurveCommand
   kMove = 0x13,    ///< MoveCommand
   kPen = 0x14,     ///< PenCommand
+  kHome = 0x15,    ///< HomeCommand
+  kMotors = 0x16,  ///< MotorsCommand
 
   kHelloReply = 0x81,
   kStatusReport = 0x82,
@@ -86,7 +90,15 @@ struct MachineConfig {
   uint32_t accel;
   /// Rest after every pen change before motion resumes, milliseconds.
   uint16_t pen_delay_ms;
+  /// kConfigFlag... bits; the others must be 0.
+  uint8_t flags;
 };
+
+/// MachineConfig::flags: PATCH, CURVE and MOVE are refused with kNotHomed
+/// until every configured axis has been homed (HOME) since the motors were
+/// last disabled.
+constexpr uint8_t kConfigFlagHomingRequired = 0x01;
+constexpr uint8_t kConfigKnownFlags = kConfigFlagHomingRequired;
 
 /// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a
 /// step-exact adaptive forward-difference path within tolerance, with
@@ -133,6 +145,30 @@ struct PenCommand {
   bool down;
 };
 
+/// Homes the axes in `axes` (bit a: axis a), one after the other in axis
+/// order, once everything before it has been executed: each moves towards
+/// its endstop (the max end for the axes in `toward_max`, else the min end)
+/// at `rate` steps/s until the switch triggers, backs off `backoff` steps,
+/// and takes that point as its position 0 (min) or travel_steps (max).
+/// The device refuses it with kBadField unless axes ≠ 0 and ⊆ the
+/// configured axes, toward_max ⊆ axes, 1 ≤ rate ≤ tick_hz and backoff ≤ the
+/// travel of every homed axis; it fails with kHomingFailed (detail = axis)
+/// when a switch does not trigger within the axis's travel plus a margin or
+/// is still triggered after the back-off.
+struct HomeCommand {
+  uint8_t axes;
+  uint8_t toward_max;
+  uint32_t rate;
+  uint32_t backoff;
+};
+
+/// Enables (true) or disables the stepper drivers once everything before it
+/// has been executed. Disabling forgets homing: the carriage may be moved by
+/// hand.
+struct MotorsCommand {
+  bool enabled;
+};
+
 /// A decoded sequenced command.
 struct Command {
   MessageType type;
@@ -144,6 +180,8 @@ struct Command {
     CurveCommand curve;
     MoveCommand move;
     PenCommand pen;
+    HomeCommand home;
+    MotorsCommand motors;
   } body;
 };
 
@@ -163,6 +201,8 @@ enum class ErrorCode : uint8_t {
   kStopped = 11,            ///< a command arrived while a stop was in progress
   kOutputFailed = 12,       ///< a step or pen output failed (status: detail = hal::IoStatus)
   kUnknownSession = 13,     ///< a resume HELLO for a session the device does not have
+  kNotHomed = 14,           ///< motion refused: the configuration requires homing first
+  kHomingFailed = 15,       ///< an endstop did not trigger (or release); detail = axis
 };
 
 /// A short, stable name ("bad length", ...).
@@ -174,6 +214,7 @@ enum class DeviceState : uint8_t {
   kRunning = 1,   ///< executing or about to
   kStopping = 2,  ///< decelerating after kStop
   kFault = 3,     ///< an execution error; `error` says which
+  kHoming = 5,    ///< executing a HOME command
 };
 
 struct HelloReply {
@@ -188,7 +229,12 @@ struct HelloReply {
   /// Axes the device drives; largest grid it evaluates.
   uint8_t max_axes;
   uint16_t max_lines;
+  /// kFeature... bits: what the device was built with.
+  uint8_t features;
 };
+
+/// HelloReply::features: the device reads endstop inputs (HOME can work).
+constexpr uint8_t kFeatureEndstops = 0x01;
 
 struct StatusReport {
   DeviceState state;
@@ -205,7 +251,16 @@ struct StatusReport {
   uint32_t executed;
   /// Unit moves (ticks that stepped) since the session began.
   uint32_t moves;
+  /// kStatusFlag... bits: motors enabled, axes homed, endstops triggered.
+  uint8_t flags;
 };
+
+/// StatusReport::flags. Axis a's homed bit is kStatusFlagHomedX << a, its
+/// endstop bit (either of its switches triggered now) kStatusFlagEndstopX << a.
+constexpr uint8_t kStatusFlagMotorsEnabled = 0x01;
+constexpr uint8_t kStatusFlagHomedX = 0x02;
+constexpr uint8_t kStatusFlagEndstopX = 0x10;
+constexpr uint8_t kStatusKnownFlags = 0x7F;
 
 struct Ack {
   /// Cumulative: every seq before this one is accepted.
