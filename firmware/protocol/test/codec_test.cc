@@ -273,8 +273,8 @@ TEST(CodecValidation, Config) {
 
 TEST(CodecValidation, HomeAndMotors) {
   const ErrorCode bad = ErrorCode::kBadField;
-  ExpectRefused(Home(0, 0, 100, 0), bad, kHomeFieldAxes);     // no axis
-  ExpectRefused(Home(0x08, 0, 100, 0), bad, kHomeFieldAxes);  // beyond Z
+  ExpectRefused(Home(0, 0, 100, 0), bad, kHomeFieldAxes);             // no axis
+  ExpectRefused(Home(0x08, 0, 100, 0), bad, kHomeFieldAxes);          // beyond Z
   ExpectRefused(Home(0x01, 0x02, 100, 0), bad, kHomeFieldTowardMax);  // not homed
   ExpectRefused(Home(0x03, 0, 0, 0), bad, kHomeFieldRate);
   ExpectRefused(Home(0x03, 0, 1, static_cast<uint32_t>(kMaxTravelSteps) + 1), bad,
@@ -360,9 +360,10 @@ TEST(CodecValidation, CurveMovePen) {
 }
 
 TEST(CodecValidation, ExactLength) {
-  const Command commands[] = {Config(), Patch(2, 3),         Patch(3, 4), Curve(2),
-                              Curve(3), Move(5, 300, 70000), Pen(true),
-                              Home(0x03, 0x01, 800, 40), Motors(false)};
+  const Command commands[] = {
+      Config(),     Patch(2, 3),         Patch(3, 4), Curve(2),
+      Curve(3),     Move(5, 300, 70000), Pen(true),   Home(0x03, 0x01, 800, 40),
+      Motors(false)};
   for (const Command& c : commands) {
     const Bytes body = CommandBody(c);
     Command out;

@@ -32,8 +32,9 @@ class EndstopInputs {
   EndstopInputs(const EndstopInputs&) = delete;
   EndstopInputs& operator=(const EndstopInputs&) = delete;
 
-  /// Axes with at least one switch, as a mask.
-  FDSURF_NODISCARD uint8_t axes_with_switches() const { return DoAxesWithSwitches(); }
+  /// The switches fitted: bit a of min_mask (max_mask) set when axis a has
+  /// a switch at its min (max) end. Constant for the object's lifetime.
+  FDSURF_NODISCARD EndstopState fitted() const { return DoFitted(); }
 
   /// Reads every switch now into *state. Cheap enough to call once per step
   /// tick (a register read on an MCU, one ioctl for all lines on Linux).
@@ -51,7 +52,7 @@ class EndstopInputs {
   ~EndstopInputs() = default;
 
  private:
-  FDSURF_NODISCARD virtual uint8_t DoAxesWithSwitches() const = 0;
+  FDSURF_NODISCARD virtual EndstopState DoFitted() const = 0;
   virtual IoStatus DoRead(EndstopState* state) = 0;
   FDSURF_NODISCARD virtual const char* DoLastError() const = 0;
 };

@@ -441,8 +441,11 @@ class Device {
   }
 
   protocol::ErrorCode ValidateHome(const protocol::HomeCommand& home, uint8_t* detail) {
-    const uint8_t switches = endstops_ != nullptr ? endstops_->axes_with_switches() : 0;
-    if ((home.axes & ~kAxisBits) != 0 || (home.axes & ~switches) != 0) {
+    const hal::EndstopState fitted =
+        endstops_ != nullptr ? endstops_->fitted() : hal::EndstopState{0, 0};
+    const uint8_t toward_min = static_cast<uint8_t>(home.axes & ~home.toward_max);
+    if ((home.axes & ~kAxisBits) != 0 || (toward_min & ~fitted.min_mask) != 0 ||
+        (home.toward_max & ~fitted.max_mask) != 0) {
       *detail = protocol::kHomeFieldAxes;
       return protocol::ErrorCode::kBadField;
     }
@@ -554,7 +557,8 @@ class Device {
       --homing_.steps_left;
       return HomingStep(steppers, !toward_max);
     }
-    if (triggered) return HomingFailed();  // the switch did not release
+    // A back-off of 0 rests on the switch on purpose; any other must release it.
+    if (triggered && homing_.backoff > 0) return HomingFailed();
     FinishHomingAxis(toward_max);
     return hal::IoStatus::kOk;
   }

@@ -154,7 +154,7 @@ struct PenCommand {
 /// configured axes, toward_max ⊆ axes, 1 ≤ rate ≤ tick_hz and backoff ≤ the
 /// travel of every homed axis; it fails with kHomingFailed (detail = axis)
 /// when a switch does not trigger within the axis's travel plus a margin or
-/// is still triggered after the back-off.
+/// is still triggered after a back-off other than 0.
 struct HomeCommand {
   uint8_t axes;
   uint8_t toward_max;
