@@ -734,7 +734,7 @@ TEST(HostLink, VersionMismatchFails) {
                            reply.size()));
   link.OnBytes(reply.data(), reply.size(), 10);
   ASSERT_TRUE(link.Failed());
-  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host 2");
+  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host 3");
 }
 
 TEST(HostLink, StopIsSentUntilAcknowledged) {
