@@ -282,7 +282,7 @@ protocol::Command MoveOf(const std::string& action, const ManualOptions& o, cons
   }
   protocol::Command command;
   command.type = protocol::MessageType::kMove;
-  for (int a = 0; a < protocol::kMaxAxes; ++a) command.body.move.target[a] = 0;
+  for (std::int32_t& target : command.body.move.target) target = 0;
   for (int a = 0; a < s.axes; ++a) {
     const bool has = static_cast<std::size_t>(a) < given;
     const double value = has ? NumberArg(action, o.args[static_cast<std::size_t>(a)]) : 0;

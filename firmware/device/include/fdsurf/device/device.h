@@ -347,7 +347,7 @@ class Device {
     motors_request_ = kNoMotorsRequest;
     homing_ = Homing{};
     endstops_now_ = hal::EndstopState{0, 0};
-    for (int a = 0; a < protocol::kMaxAxes; ++a) applied_travel_[a] = 0;
+    for (int32_t& travel : applied_travel_) travel = 0;
     generator_.Reset(motion_.position(), false);
   }
 
