@@ -22,6 +22,7 @@ class DeviceRunner {
   FDSURF_NODISCARD virtual const protocol::FrameDecoderStats& frame_stats() const = 0;
   FDSURF_NODISCARD virtual std::uint32_t executed() const = 0;
   FDSURF_NODISCARD virtual motion::ValidationWork validation_work() const = 0;
+  virtual void set_endstops(hal::EndstopInputs* endstops) = 0;
 };
 
 }  // namespace internal
@@ -48,6 +49,7 @@ class AxesRunner final : public internal::DeviceRunner {
   FDSURF_NODISCARD motion::ValidationWork validation_work() const override {
     return device_.validation_work();
   }
+  void set_endstops(hal::EndstopInputs* endstops) override { device_.set_endstops(endstops); }
 
  private:
   device::Device<kAxes, 8, 1024> device_;
@@ -138,6 +140,10 @@ SimulatedPlotter::SimulatedPlotter(const PlotterOptions& options)
     runner_ = std::make_unique<AxesRunner<2>>(options.tick_hz);
   } else {
     runner_ = std::make_unique<AxesRunner<3>>(options.tick_hz);
+  }
+  if (options.endstops) {
+    endstops_ = std::make_unique<hal::SimEndstops>(steps_, options.endstop_options);
+    runner_->set_endstops(endstops_.get());
   }
 }
 

@@ -426,6 +426,47 @@ TEST_F(SerialCli, AJobKilledMidwayIsResumedFromItsJournalDrawingNothingTwice) {
   EXPECT_EQ(StopDevice()["hellos"], "0");
 }
 
+// `fdsurf machine` against the pty device with min endstops 800 and 400
+// steps (10 and 5 mm) from where the carriage starts: the device keeps its
+// position and homing between invocations, as a powered board does.
+TEST_F(SerialCli, MachineCommandsHomeJogAndForgetHomingWithTheMotorsOff) {
+  StartDevice("--speedup 20 --endstops 800,400");
+  const std::string machine = " --device 'serial:" + link_ + "' --travel 100x80";
+  Result r = Run("machine where" + machine);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out,
+            "position x 0, y 0 mm (steps 0, 0); pen up; motors off; homed none; endstops "
+            "triggered none\n");
+  r = Run("machine goto 10 10 --require-homing" + machine);
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("not homed (run `fdsurf machine home` first)"), std::string::npos) << r.err;
+  r = Run("machine home --rate 40 --backoff 1" + machine);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("position x 0, y 0 mm (steps 0, 0); pen up; motors on; homed xy;"),
+            std::string::npos)
+      << r.out;
+  r = Run("machine goto 20 10 --require-homing" + machine);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("position x 20, y 10 mm (steps 1600, 800)"), std::string::npos) << r.out;
+  r = Run("machine jog -5 2 --require-homing" + machine);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("position x 15, y 12 mm (steps 1200, 960)"), std::string::npos) << r.out;
+  r = Run("machine jog 90 0" + machine);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("machine jog: the target x 105 mm is outside the travel 0..100 mm"),
+            std::string::npos)
+      << r.err;
+  r = Run("machine motors off" + machine);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("motors off; homed none"), std::string::npos) << r.out;
+  r = Run("machine goto 20 10 --require-homing" + machine);
+  EXPECT_EQ(r.exit_code, 3) << r.out;
+  // The search (10, 5 mm), the back-off (1 mm each), then 20, 10 and 5, 2 mm of moves.
+  auto report = StopDevice();
+  EXPECT_EQ(report["steps_x"], std::to_string(800 + 80 + 1600 + 400));
+  EXPECT_EQ(report["steps_y"], std::to_string(400 + 80 + 800 + 160));
+}
+
 TEST_F(SerialCli, StreamsAJobThatTheDeviceExecutesOnce) {
   StartDevice("--speedup 20");
   const Result r = Stream();

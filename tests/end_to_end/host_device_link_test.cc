@@ -57,6 +57,7 @@ struct FakeSink {
   }
   uint8_t Credits() const { return static_cast<uint8_t>(capacity - queue.size()); }
   uint8_t QueueCapacity() const { return capacity; }
+  uint8_t Features() const { return 0; }
   uint32_t TickHz() const { return 40000; }
   uint8_t MaxAxes() const { return 3; }
   void FillStatus(StatusReport* report) const {

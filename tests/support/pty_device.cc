@@ -5,7 +5,7 @@
 //
 //   pty_device --link PATH [--report FILE] [--tick-hz 20000] [--speedup 1]
 //              [--silent-ms N] [--never-answer] [--hangup-after-bytes N]
-//              [--back-after-ms M] [--time-limit-s S]
+//              [--back-after-ms M] [--time-limit-s S] [--endstops X,Y]
 //
 // --silent-ms N          a board reset by DTR: from the first byte the host
 //                        sends, N ms of bytes are read and ignored (the
@@ -16,6 +16,8 @@
 //                        opens a new pty and points the symlink at it. The
 //                        Device keeps its state and keeps moving meanwhile.
 // --speedup K            K device ticks of 1/tick-hz s per real 1/tick-hz s.
+// --endstops X,Y         min endstop switches on X and Y; the carriage starts
+//                        X, Y steps from them (so HOME has to search).
 //
 // Prints "ready" once the link exists. On SIGTERM, SIGINT or the time limit
 // (30 s) it writes the report (key value lines: executed commands, steps per
@@ -40,6 +42,7 @@
 #include <string>
 
 #include "fdsurf/device/device.h"
+#include "fdsurf/hal/inputs.h"
 #include "fdsurf/hal/outputs.h"
 
 namespace {
@@ -59,6 +62,8 @@ struct Options {
   long hangup_after_bytes = -1;
   long back_after_ms = 500;
   double time_limit_s = 30;
+  bool endstops = false;
+  long endstop_offset[2] = {0, 0};
 };
 
 // Counts steps per axis and folds every step and pen change, in order, into
@@ -68,6 +73,7 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
  public:
   RecordingOutputs() : StepDirOutputs(2) {}
   uint64_t steps[3] = {0, 0, 0};
+  int64_t position[3] = {0, 0, 0};  // signed, for the endstops
   uint64_t digest = 1469598103934665603ull;
   /// The same over the steps only (a pause adds a pen lift and lowering).
   uint64_t step_digest = 1469598103934665603ull;
@@ -88,7 +94,10 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
     return fdsurf::hal::IoStatus::kOk;
   }
   fdsurf::hal::IoStatus DoStep(uint8_t axis_mask) override {
-    for (int a = 0; a < 3; ++a) steps[a] += (axis_mask >> a) & 1u;
+    for (int a = 0; a < 3; ++a) {
+      steps[a] += (axis_mask >> a) & 1u;
+      if ((axis_mask >> a & 1u) != 0) position[a] += (negative_ >> a & 1u) != 0 ? -1 : 1;
+    }
     const auto byte = static_cast<uint8_t>(axis_mask | (negative_ & axis_mask) << 4);
     Fold(byte);
     step_digest ^= byte;
@@ -102,6 +111,28 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
   }
   const char* DoLastError() const override { return ""; }
   uint8_t negative_ = 0;
+};
+
+// Min switches on X and Y where the carriage's real position (counted steps
+// plus the start offset) reaches 0.
+class MinSwitches final : public fdsurf::hal::EndstopInputs {
+ public:
+  MinSwitches(const RecordingOutputs& outputs, const long (&offset)[2])
+      : outputs_(outputs), offset_{offset[0], offset[1]} {}
+
+ private:
+  fdsurf::hal::EndstopState DoFitted() const override { return {0x03, 0}; }
+  fdsurf::hal::IoStatus DoRead(fdsurf::hal::EndstopState* state) override {
+    state->min_mask = 0;
+    state->max_mask = 0;
+    for (int a = 0; a < 2; ++a) {
+      if (outputs_.position[a] + offset_[a] <= 0) state->min_mask |= static_cast<uint8_t>(1u << a);
+    }
+    return fdsurf::hal::IoStatus::kOk;
+  }
+  const char* DoLastError() const override { return ""; }
+  const RecordingOutputs& outputs_;
+  long offset_[2];
 };
 
 bool ParseOptions(int argc, char** argv, Options* o) {
@@ -124,6 +155,13 @@ bool ParseOptions(int argc, char** argv, Options* o) {
       o->hangup_after_bytes = std::strtol(argv[++i], nullptr, 10);
     } else if (arg == "--back-after-ms" && has_value) {
       o->back_after_ms = std::strtol(argv[++i], nullptr, 10);
+    } else if (arg == "--endstops" && has_value) {
+      o->endstops =
+          std::sscanf(argv[++i], "%ld,%ld", &o->endstop_offset[0], &o->endstop_offset[1]) == 2;
+      if (!o->endstops) {
+        std::fprintf(stderr, "pty_device: --endstops X,Y (steps)\n");
+        return false;
+      }
     } else if (arg == "--time-limit-s" && has_value) {
       o->time_limit_s = std::strtod(argv[++i], nullptr);
     } else {
@@ -181,6 +219,7 @@ struct Run {
   const Options& o;
   fdsurf::device::Device<2> device;
   RecordingOutputs outputs;
+  MinSwitches switches{outputs, o.endstop_offset};
   Pty pty;
   long bytes_in = 0;
   bool heard = false;  // a first byte arrived: the "reset" happened
@@ -189,7 +228,9 @@ struct Run {
   Clock::time_point down_since;
   uint64_t ticks_done = 0;
 
-  explicit Run(const Options& options) : o(options), device(options.tick_hz) {}
+  explicit Run(const Options& options) : o(options), device(options.tick_hz) {
+    if (options.endstops) device.set_endstops(&switches);
+  }
 
   // Bytes in from the host, replies out.
   void Service() {

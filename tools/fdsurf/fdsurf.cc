@@ -13,6 +13,7 @@
 #include "fdsurf/host/errors.h"
 #include "fdsurf_version.h"
 #include "machine/machine_command.h"
+#include "machine/manual_command.h"
 #include "machine/profile.h"
 #include "stream_command.h"
 
@@ -29,6 +30,8 @@ struct Commands {
   JoinsOptions joins_options;
   PortsOptions ports_options;
   MachineShowOptions machine_show_options;
+  ManualOptions manual_options;
+  std::string manual_action;  // home, jog, ... when one was parsed
   /// --machine of stream and plot (machine/profile.h).
   std::string stream_machine;
   std::string plot_machine;
@@ -77,11 +80,13 @@ void AddCommands(CLI::App* app, Commands* c) {
       "List the serial ports (USB VID:PID, serial number, product); --probe asks each "
       "for the fdsurf firmware.");
   AddPortsOptions(c->ports, &c->ports_options);
-  c->machine = app->add_subcommand("machine", "Machine profiles (docs/machines.md).");
+  c->machine = app->add_subcommand(
+      "machine", "Machine profiles and manual control: home, jog, goto (docs/machines.md).");
   c->machine->require_subcommand(1);
   c->machine_show = c->machine->add_subcommand(
       "show", "Print the effective machine settings and where each came from.");
   AddMachineShowOptions(c->machine_show, &c->machine_show_options);
+  AddManualCommands(c->machine, &c->manual_options, &c->manual_action);
 }
 
 // CLI11 would only say "a subcommand is required" for a mistyped command.
@@ -107,6 +112,7 @@ int RunParsed(Commands& c) {
     if (c.joins->parsed()) return RunJoins(c.joins_options);
     if (c.ports->parsed()) return RunPorts(c.ports_options);
     if (c.machine_show->parsed()) return RunMachineShow(c.machine_show_options);
+    if (!c.manual_action.empty()) return RunManual(c.manual_action, c.manual_options);
   } catch (const OptionError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.MessageFor(FlagFor(e.field())).c_str());
     return 2;

@@ -167,6 +167,8 @@ void AddJournalOptions(CLI::App* command, StreamOptions* o) {
 
 }  // namespace
 
+MachineOptions StreamMachine(const StreamOptions& o) { return Machine(o); }
+
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   AddInputOptions(command, &o->file, &o->input_format, &o->reader);
   command

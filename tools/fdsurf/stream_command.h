@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli_options.h"
+#include "fdsurf/host/stream.h"
 
 namespace CLI {
 class App;
@@ -97,5 +98,10 @@ void AddStreamOptions(CLI::App* command, StreamOptions* options);
 /// 2 for bad input, 3 when the device refused the job or the link failed.
 /// Throws InputError / OutputError / EngineError as the other commands do.
 int RunStream(const StreamOptions& options);
+
+/// The machine stream drives for `o` (--step, --travel, --speed, --accel,
+/// --pen-delay in o.units); InputError for a bad value. `fdsurf machine`
+/// uses it too.
+MachineOptions StreamMachine(const StreamOptions& o);
 
 }  // namespace fdsurf::host

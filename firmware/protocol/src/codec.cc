@@ -70,6 +70,7 @@ void WriteCommandBody(const Command& command, Writer* w) {
       w->PutU16(c.pen_delay_ms);
       w->PutU16(c.servo_up_us);
       w->PutU16(c.servo_down_us);
+      w->Put(c.flags);
       break;
     }
     case MessageType::kPatch: {
@@ -109,6 +110,17 @@ void WriteCommandBody(const Command& command, Writer* w) {
       break;
     case MessageType::kPen:
       w->Put(BoolByte(command.body.pen.down));
+      break;
+    case MessageType::kHome: {
+      const HomeCommand& h = command.body.home;
+      w->Put(h.axes);
+      w->Put(h.toward_max);
+      w->PutU32(h.rate);
+      w->PutU32(h.backoff);
+      break;
+    }
+    case MessageType::kMotors:
+      w->Put(BoolByte(command.body.motors.enabled));
       break;
     default:
       break;  // not a command: an empty body the decoder refuses
@@ -258,6 +270,8 @@ void ReadConfig(Reader* r, MachineConfig* c) {
   r->Check(c->accel >= 1, kConfigFieldAccel);
   c->pen_delay_ms = r->U16(kConfigFieldPenDelay);
   ReadServo(r, c);
+  c->flags = r->U8(kConfigFieldFlags);
+  r->Check((c->flags & ~kConfigKnownFlags) == 0, kConfigFieldFlags);
   r->End(kConfigFieldCount);
 }
 
@@ -334,7 +348,33 @@ void ReadPen(Reader* r, PenCommand* p) {
   r->End(kPenFieldCount);
 }
 
+// The axis mask must name at least one axis and none beyond kMaxAxes; the
+// device checks it against its configuration.
+void ReadHome(Reader* r, HomeCommand* h) {
+  constexpr uint8_t kAxisBits = (1u << kMaxAxes) - 1u;
+  h->axes = r->U8(kHomeFieldAxes);
+  r->Check(h->axes != 0 && (h->axes & ~kAxisBits) == 0, kHomeFieldAxes);
+  h->toward_max = r->U8(kHomeFieldTowardMax);
+  r->Check((h->toward_max & ~h->axes) == 0, kHomeFieldTowardMax);
+  h->rate = r->U32(kHomeFieldRate);
+  r->Check(h->rate >= 1, kHomeFieldRate);
+  h->backoff = r->U32(kHomeFieldBackoff);
+  r->Check(h->backoff <= static_cast<uint32_t>(kMaxTravelSteps), kHomeFieldBackoff);
+  r->End(kHomeFieldCount);
+}
+
+void ReadMotors(Reader* r, MotorsCommand* m) {
+  const uint8_t enabled = r->U8(kMotorsFieldEnabled);
+  r->Check(enabled <= 1, kMotorsFieldEnabled);
+  m->enabled = enabled == 1;
+  r->End(kMotorsFieldCount);
+}
+
 bool ErrorCodeValid(uint8_t code) { return code <= kLastErrorCode; }
+
+bool DeviceStateValid(uint8_t state) {
+  return state <= static_cast<uint8_t>(DeviceState::kHoming);
+}
 
 }  // namespace
 
@@ -403,6 +443,7 @@ size_t EncodeHelloReply(uint16_t token, const HelloReply& reply, uint8_t* out, s
   encoder.PutU32(reply.tick_hz);
   encoder.Put(reply.max_axes);
   encoder.PutU16(reply.max_lines);
+  encoder.Put(reply.features);
   return encoder.Finish();
 }
 
@@ -422,6 +463,7 @@ size_t EncodeStatusReport(uint16_t token, const StatusReport& report, uint8_t* o
   encoder.PutU16(report.next_seq);
   encoder.PutU32(report.executed);
   encoder.PutU32(report.moves);
+  encoder.Put(report.flags);
   return encoder.Finish();
 }
 
@@ -472,6 +514,12 @@ DecodeResult DecodeCommand(const Frame& frame, Command* out) {
       break;
     case MessageType::kPen:
       ReadPen(&reader, &out->body.pen);
+      break;
+    case MessageType::kHome:
+      ReadHome(&reader, &out->body.home);
+      break;
+    case MessageType::kMotors:
+      ReadMotors(&reader, &out->body.motors);
       break;
     default:
       return DecodeResult{ErrorCode::kUnknownType, 0};
@@ -534,13 +582,15 @@ DecodeResult DecodeReply(const Frame& frame, Reply* out) {
       r.Check(DimsValid(h.max_axes), kHelloReplyFieldMaxAxes);
       h.max_lines = r.U16(kHelloReplyFieldMaxLines);
       r.Check(h.max_lines >= 2, kHelloReplyFieldMaxLines);
+      h.features = r.U8(kHelloReplyFieldFeatures);
+      r.Check((h.features & ~kFeatureEndstops) == 0, kHelloReplyFieldFeatures);
       r.End(kHelloReplyFieldCount);
       break;
     }
     case MessageType::kStatusReport: {
       StatusReport& s = out->body.status;
       const uint8_t state = r.U8(kStatusFieldState);
-      r.Check(state <= static_cast<uint8_t>(DeviceState::kPaused), kStatusFieldState);
+      r.Check(DeviceStateValid(state), kStatusFieldState);
       s.state = static_cast<DeviceState>(state);
       const uint8_t error = r.U8(kStatusFieldError);
       r.Check(ErrorCodeValid(error), kStatusFieldError);
@@ -557,6 +607,8 @@ DecodeResult DecodeReply(const Frame& frame, Reply* out) {
       s.next_seq = r.U16(kStatusFieldNextSeq);
       s.executed = r.U32(kStatusFieldExecuted);
       s.moves = r.U32(kStatusFieldMoves);
+      s.flags = r.U8(kStatusFieldFlags);
+      r.Check((s.flags & ~kStatusKnownFlags) == 0, kStatusFieldFlags);
       r.End(kStatusFieldCount);
       break;
     }
@@ -621,6 +673,10 @@ const char* ErrorName(ErrorCode code) {
       return "output failed";
     case ErrorCode::kUnknownSession:
       return "unknown session";
+    case ErrorCode::kNotHomed:
+      return "not homed";
+    case ErrorCode::kHomingFailed:
+      return "homing failed";
   }
   return "unknown error";
 }

@@ -13,6 +13,7 @@ struct NullSink {
   ErrorCode Accept(const Command& /*command*/, uint8_t* /*detail*/) { return ErrorCode::kNone; }
   FDSURF_NODISCARD uint8_t Credits() const { return 1; }
   FDSURF_NODISCARD uint8_t QueueCapacity() const { return 1; }
+  FDSURF_NODISCARD uint8_t Features() const { return 0; }
   FDSURF_NODISCARD uint32_t TickHz() const { return 1; }
   FDSURF_NODISCARD uint8_t MaxAxes() const { return 2; }
   void FillStatus(StatusReport* /*report*/) const {}

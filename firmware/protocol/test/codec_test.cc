@@ -118,6 +118,22 @@ Command Pen(bool down) {
   return c;
 }
 
+Command Home(uint8_t axes, uint8_t toward_max, uint32_t rate, uint32_t backoff) {
+  Command c;
+  c.type = MessageType::kHome;
+  c.seq = 5;
+  c.body.home = HomeCommand{axes, toward_max, rate, backoff};
+  return c;
+}
+
+Command Motors(bool enabled) {
+  Command c;
+  c.type = MessageType::kMotors;
+  c.seq = 6;
+  c.body.motors.enabled = enabled;
+  return c;
+}
+
 // Round trip through the wire; the decoded command re-encodes to the same
 // body (a byte-exact comparison of every field that is sent).
 void ExpectRoundTrip(const Command& command) {
@@ -159,6 +175,27 @@ TEST(Codec, CommandRoundTrips) {
   ExpectRoundTrip(Move(kMaxTravelSteps, 1, 127));
   ExpectRoundTrip(Pen(true));
   ExpectRoundTrip(Pen(false));
+  Command homing_required = Config();
+  homing_required.body.config.flags = kConfigFlagHomingRequired;
+  ExpectRoundTrip(homing_required);
+  ExpectRoundTrip(Home(0x01, 0, 1, 0));
+  ExpectRoundTrip(Home(0x07, 0x05, 0xFFFFFFFFu, static_cast<uint32_t>(kMaxTravelSteps)));
+  ExpectRoundTrip(Motors(true));
+  ExpectRoundTrip(Motors(false));
+}
+
+// HOME is axes u8, toward_max u8, rate u32, backoff u32 (10 bytes); MOTORS
+// one byte; CONFIG's flags byte follows pen_delay_ms.
+TEST(Codec, HomeMotorsAndFlagsBodies) {
+  EXPECT_EQ(CommandBody(Home(0x03, 0x02, 0x01020304u, 0x0A0B0C0Du)),
+            (Bytes{0x03, 0x02, 0x04, 0x03, 0x02, 0x01, 0x0D, 0x0C, 0x0B, 0x0A}));
+  EXPECT_EQ(CommandBody(Motors(true)), Bytes{1});
+  EXPECT_EQ(CommandBody(Motors(false)), Bytes{0});
+  Command config = Config();
+  config.body.config.flags = kConfigFlagHomingRequired;
+  const Bytes body = CommandBody(config);
+  ASSERT_EQ(body.size(), 36u);
+  EXPECT_EQ(body.back(), kConfigFlagHomingRequired);
 }
 
 TEST(Codec, GeometryValuesExactAtTheLimits) {
@@ -251,6 +288,28 @@ TEST(CodecValidation, Config) {
   ExpectRefused(servo(1000, 2501), bad, kConfigFieldServoDown);
   ExpectRefused(servo(0, 2000), bad, kConfigFieldServoUp);    // one 0 is not a switch
   ExpectRefused(servo(1000, 0), bad, kConfigFieldServoDown);  // nor the other
+  ExpectRefused(with([](MachineConfig* m) { m->flags = 0x02; }), bad, kConfigFieldFlags);
+  ExpectRefused(with([](MachineConfig* m) { m->flags = 0x80; }), bad, kConfigFieldFlags);
+}
+
+TEST(CodecValidation, HomeAndMotors) {
+  const ErrorCode bad = ErrorCode::kBadField;
+  ExpectRefused(Home(0, 0, 100, 0), bad, kHomeFieldAxes);             // no axis
+  ExpectRefused(Home(0x08, 0, 100, 0), bad, kHomeFieldAxes);          // beyond Z
+  ExpectRefused(Home(0x01, 0x02, 100, 0), bad, kHomeFieldTowardMax);  // not homed
+  ExpectRefused(Home(0x03, 0, 0, 0), bad, kHomeFieldRate);
+  ExpectRefused(Home(0x03, 0, 1, static_cast<uint32_t>(kMaxTravelSteps) + 1), bad,
+                kHomeFieldBackoff);
+  Command out;
+  EXPECT_EQ(DecodeCommand(BodyFrame(MessageType::kMotors, Bytes{2}), &out).field,
+            kMotorsFieldEnabled);
+  const DecodeResult longer = DecodeCommand(BodyFrame(MessageType::kMotors, Bytes{1, 0}), &out);
+  EXPECT_EQ(longer.code, ErrorCode::kBadLength);
+  EXPECT_EQ(longer.field, kMotorsFieldCount);
+  const Bytes home_short = {0x01, 0x00, 0x10, 0x00, 0x00, 0x00, 0x05, 0x00, 0x00};
+  const DecodeResult cut = DecodeCommand(BodyFrame(MessageType::kHome, home_short), &out);
+  EXPECT_EQ(cut.code, ErrorCode::kBadLength);
+  EXPECT_EQ(cut.field, kHomeFieldBackoff);
 }
 
 TEST(CodecValidation, Patch) {
@@ -322,8 +381,10 @@ TEST(CodecValidation, CurveMovePen) {
 }
 
 TEST(CodecValidation, ExactLength) {
-  const Command commands[] = {Config(), Patch(2, 3),         Patch(3, 4), Curve(2),
-                              Curve(3), Move(5, 300, 70000), Pen(true)};
+  const Command commands[] = {
+      Config(),     Patch(2, 3),         Patch(3, 4), Curve(2),
+      Curve(3),     Move(5, 300, 70000), Pen(true),   Home(0x03, 0x01, 800, 40),
+      Motors(false)};
   for (const Command& c : commands) {
     const Bytes body = CommandBody(c);
     Command out;
@@ -343,9 +404,13 @@ TEST(CodecValidation, ExactLength) {
   const Bytes pen = {1, 0};
   EXPECT_EQ(DecodeCommand(BodyFrame(MessageType::kPen, pen), &out).field, kPenFieldCount);
   Bytes config_short = CommandBody(Config());
-  ASSERT_EQ(config_short.size(), 39u);
-  config_short.pop_back();  // servo_down_us cut short
+  ASSERT_EQ(config_short.size(), 40u);
+  config_short.pop_back();  // flags missing
   DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
+  EXPECT_EQ(r.code, ErrorCode::kBadLength);
+  EXPECT_EQ(r.field, kConfigFieldFlags);
+  config_short.pop_back();  // servo_down_us cut short
+  r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
   EXPECT_EQ(r.field, kConfigFieldServoDown);
   config_short.resize(35 - 1);  // pen_delay_ms cut short
@@ -392,7 +457,7 @@ TEST(CodecValidation, UnknownTypes) {
   const Bytes body = {1};
   for (int type = 0; type < 256; ++type) {
     const DecodeResult r = DecodeCommand(BodyFrame(static_cast<MessageType>(type), body), &out);
-    if (type >= 0x10 && type <= 0x14) {
+    if (type >= 0x10 && type <= 0x16) {
       EXPECT_NE(r.code, ErrorCode::kUnknownType);
     } else {
       EXPECT_EQ(r.code, ErrorCode::kUnknownType) << type;
@@ -475,7 +540,7 @@ Reply RoundTripReply(const Bytes& wire) {
 
 TEST(Codec, ReplyRoundTrips) {
   Bytes wire(kMaxEncodedFrameBytes);
-  const HelloReply hello{kProtocolVersion, 0xFFFE, 7, 8, 40000, 3, kMaxLines};
+  const HelloReply hello{kProtocolVersion, 0xFFFE, 7, 8, 40000, 3, kMaxLines, kFeatureEndstops};
   wire.resize(EncodeHelloReply(77, hello, wire.data(), wire.size()));
   Reply r = RoundTripReply(wire);
   EXPECT_EQ(r.type, MessageType::kHelloReply);
@@ -486,6 +551,7 @@ TEST(Codec, ReplyRoundTrips) {
   EXPECT_EQ(r.body.hello.tick_hz, 40000u);
   EXPECT_EQ(r.body.hello.max_axes, 3);
   EXPECT_EQ(r.body.hello.max_lines, kMaxLines);
+  EXPECT_EQ(r.body.hello.features, kFeatureEndstops);
 
   const StatusReport status{DeviceState::kFault,
                             ErrorCode::kOutOfTravel,
@@ -496,7 +562,8 @@ TEST(Codec, ReplyRoundTrips) {
                             5,
                             0x8001,
                             0xFFFFFFFFu,
-                            123456789u};
+                            123456789u,
+                            0x7F};
   wire.assign(kMaxEncodedFrameBytes, 0);
   wire.resize(EncodeStatusReport(0xABCD, status, wire.data(), wire.size()));
   r = RoundTripReply(wire);
@@ -514,6 +581,7 @@ TEST(Codec, ReplyRoundTrips) {
   EXPECT_EQ(s.next_seq, 0x8001);
   EXPECT_EQ(s.executed, 0xFFFFFFFFu);
   EXPECT_EQ(s.moves, 123456789u);
+  EXPECT_EQ(s.flags, 0x7F);
 
   wire.assign(kMaxEncodedFrameBytes, 0);
   wire.resize(EncodeAck(5, Ack{6, 2}, wire.data(), wire.size()));
@@ -546,7 +614,7 @@ TEST(CodecValidation, Replies) {
     return DecodeReply(BodyFrame(type, body), &out);
   };
   // HELLO_REPLY: capacity 0, credits above capacity, tick 0, axes 4, lines 1.
-  const Bytes good = {1, 0, 0, 2, 4, 0x10, 0, 0, 0, 3, 0x01, 0x04};
+  const Bytes good = {1, 0, 0, 2, 4, 0x10, 0, 0, 0, 3, 0x01, 0x04, 0x01};
   EXPECT_TRUE(decode(MessageType::kHelloReply, good).ok());
   auto hello_with = [&](size_t at, uint8_t value) {
     Bytes b = good;
@@ -561,14 +629,22 @@ TEST(CodecValidation, Replies) {
   Bytes tick0 = good;
   tick0[5] = 0;
   EXPECT_EQ(decode(MessageType::kHelloReply, tick0).field, kHelloReplyFieldTickHz);
+  EXPECT_EQ(hello_with(12, 0x02).field, kHelloReplyFieldFeatures);  // unknown feature
+  const Bytes no_features(good.begin(), good.end() - 1);
+  EXPECT_EQ(decode(MessageType::kHelloReply, no_features).field, kHelloReplyFieldFeatures);
   // STATUS_REPORT: state, error code and pen byte ranges.
-  Bytes status(28, 0);
+  Bytes status(29, 0);
   EXPECT_TRUE(decode(MessageType::kStatusReport, status).ok());
   status[0] = 4;  // kPaused (protocol version 3)
   EXPECT_TRUE(decode(MessageType::kStatusReport, status).ok());
-  status[0] = 5;
+  status[0] = static_cast<uint8_t>(DeviceState::kHoming);
+  EXPECT_TRUE(decode(MessageType::kStatusReport, status).ok());
+  status[0] = 6;
   EXPECT_EQ(decode(MessageType::kStatusReport, status).field, kStatusFieldState);
   status[0] = 0;
+  status[28] = 0x80;  // flags: bit 7 is unused
+  EXPECT_EQ(decode(MessageType::kStatusReport, status).field, kStatusFieldFlags);
+  status[28] = 0;
   status[1] = kLastErrorCode + 1;
   EXPECT_EQ(decode(MessageType::kStatusReport, status).field, kStatusFieldError);
   status[1] = 0;
@@ -624,7 +700,7 @@ TEST(Codec, DecoderFuzz) {
           : pick == 1 ? static_cast<uint8_t>(0x80 | rng())
                       : static_cast<uint8_t>(rng());
     }
-    const auto type = static_cast<MessageType>(rng() % 4 == 0 ? rng() : 0x10 + rng() % 5);
+    const auto type = static_cast<MessageType>(rng() % 4 == 0 ? rng() : 0x10 + rng() % 7);
     const Frame frame{static_cast<uint8_t>(type), static_cast<uint16_t>(rng()), body.data(),
                       body.size(), true};
     Command command;

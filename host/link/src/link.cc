@@ -41,6 +41,10 @@ const char* TypeName(MessageType type) {
       return "move";
     case MessageType::kPen:
       return "pen";
+    case MessageType::kHome:
+      return "home";
+    case MessageType::kMotors:
+      return "motors";
     default:
       return "frame";
   }
@@ -64,7 +68,10 @@ std::string FieldName(MessageType type, uint8_t index) {
         return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
       }
       const std::array<const char*, 3> rest = {"max_rate", "accel", "pen_delay_ms"};
-      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldCount) {
+      if (index == p::kConfigFieldFlags) {
+        return "flags";
+      }
+      if (index >= p::kConfigFieldMaxRate && index <= p::kConfigFieldPenDelay) {
         return rest[index - p::kConfigFieldMaxRate];
       }
       break;
@@ -101,6 +108,18 @@ std::string FieldName(MessageType type, uint8_t index) {
     case MessageType::kPen:
       if (index == p::kPenFieldDown) {
         return "down";
+      }
+      break;
+    case MessageType::kHome: {
+      const std::array<const char*, 4> fields = {"axes", "toward_max", "rate", "backoff"};
+      if (index < p::kHomeFieldCount) {
+        return fields[index];
+      }
+      break;
+    }
+    case MessageType::kMotors:
+      if (index == p::kMotorsFieldEnabled) {
+        return "enabled";
       }
       break;
     default:

@@ -30,6 +30,8 @@ const char* StateName(protocol::DeviceState state) {
       return "fault";
     case protocol::DeviceState::kPaused:
       return "paused";
+    case protocol::DeviceState::kHoming:
+      return "homing";
   }
   return "unknown";
 }

@@ -13,6 +13,7 @@
 
 #include "fdsurf/config/nodiscard.h"
 #include "fdsurf/hal/sim.h"
+#include "fdsurf/hal/sim_endstops.h"
 #include "fdsurf/host/link.h"
 #include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/device_link.h"
@@ -54,6 +55,9 @@ struct PlotterOptions {
   std::uint64_t fault_seed = 1;
   /// What the device's validation costs in time (free by default).
   DeviceCost device_cost;
+  /// Endstop switches for HOME (hal/sim_endstops.h): none unless `endstops`.
+  bool endstops = false;
+  hal::SimEndstopOptions endstop_options;
 };
 
 /// Progress of a run: virtual time, commands acknowledged and executed.
@@ -110,6 +114,8 @@ class SimulatedPlotter {
   FDSURF_NODISCARD const std::vector<hal::PenEvent>& pen_events() const { return pen_.events(); }
   /// The machine's position now (steps), from the recorded pulses.
   FDSURF_NODISCARD std::array<std::int64_t, 3> position() const;
+  /// The endstop switches, or nullptr without options().endstops.
+  FDSURF_NODISCARD const hal::SimEndstops* endstops() const { return endstops_.get(); }
 
   /// The pen-down strokes, rebuilt from the recorded step and pen events.
   FDSURF_NODISCARD std::vector<DrawnPath> DrawnPaths() const;
@@ -122,6 +128,7 @@ class SimulatedPlotter {
   hal::SimStepDir steps_;
   hal::SimPen pen_;
   hal::SimTransportPair link_;
+  std::unique_ptr<hal::SimEndstops> endstops_;
   std::unique_ptr<FaultyTransport> device_end_;
   std::unique_ptr<internal::DeviceRunner> runner_;
   std::uint64_t unplug_at_us_ = 0;

@@ -30,12 +30,24 @@
 // it is plannable), so execution never meets a refusal; a command that would
 // fail is answered with an ERROR and never queued. The validation's cost per
 // frame is bounded (motion::ValidateCommand, docs/motion.md).
+//
+// Homing (HOME, docs/protocol.md): a device given endstop inputs
+// (set_endstops) reads them once per tick. A HOME waits until everything
+// before it has executed and the pen is up, then Tick() itself steps each
+// axis towards its switch at the command's constant rate (a phase
+// accumulator: one addition and one comparison per tick, no division), backs
+// off, and sets the axis's position; the path generator and its travel
+// checks are not involved. MOTORS 0 disables the drivers and forgets homing.
+// A configuration with kConfigFlagHomingRequired makes Accept() refuse
+// PATCH, CURVE and MOVE (kNotHomed) unless every axis will be homed by the
+// time they run (a HOME accepted before them counts).
 #pragma once
 
 #include <stddef.h>
 #include <stdint.h>
 
 #include "fdsurf/config/nodiscard.h"
+#include "fdsurf/hal/inputs.h"
 #include "fdsurf/hal/outputs.h"
 #include "fdsurf/hal/transport.h"
 #include "fdsurf/motion/motion_loop.h"
@@ -77,6 +89,11 @@ class Device {
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
 
+  /// The endstop switches Tick() reads (not owned; nullptr: none, the
+  /// default, and HOME is refused). Set before the first Service(): HELLO's
+  /// features report it.
+  void set_endstops(hal::EndstopInputs* endstops) { endstops_ = endstops; }
+
   // --- I/O --------------------------------------------------------------
 
   void OnByte(uint8_t byte) { link_.OnByte(byte); }
@@ -111,6 +128,7 @@ class Device {
   /// 8-bit MCU) still gets back to Service() and answers the host.
   void Fill(uint16_t max_entries = 0xFFFFu) {
     FinishStopAtRest();
+    if (!FinishHomingAtRest()) return;
     for (uint16_t pushed = 0; pushed < max_entries;) {
       if (fault_) {
         DropQueue();
@@ -122,6 +140,16 @@ class Device {
         const protocol::Command& next = queue_[queue_head_];
         if (next.type == protocol::MessageType::kConfig) {
           if (!ApplyConfigAtRest(next.body.config)) return;
+          PopCommand();
+          continue;
+        }
+        if (next.type == protocol::MessageType::kHome) {
+          // Tick() does the homing; nothing is expanded until it ends.
+          if (StartHomingAtRest(next.body.home)) PopCommand();
+          return;
+        }
+        if (next.type == protocol::MessageType::kMotors) {
+          if (!RequestMotorsAtRest(next.body.motors.enabled)) return;
           PopCommand();
           continue;
         }
@@ -156,13 +184,19 @@ class Device {
       const hal::IoStatus configured = pen.ConfigureServo(pen_servo_up_us_, pen_servo_down_us_);
       if (configured != hal::IoStatus::kOk) return OutputFailed(configured);
     }
+    hal::IoStatus status = ReadEndstops();
+    if (status == hal::IoStatus::kOk && motors_request_ != kNoMotorsRequest) {
+      status = ApplyMotorsRequest(steppers);
+    }
+    if (status == hal::IoStatus::kOk && homing_.active) status = HomingTick(steppers);
+    if (status != hal::IoStatus::kOk) return OutputFailed(status);
+    if (homing_.active) return hal::IoStatus::kOk;
     if (halt_outputs_ || pause_ != PausePhase::kNone) {
       bool consumed = false;
-      const hal::IoStatus status = TickPauseOrHalt(steppers, pen, &consumed);
-      if (status != hal::IoStatus::kOk) return OutputFailed(status);
-      if (consumed) return status;
+      const hal::IoStatus paused = TickPauseOrHalt(steppers, pen, &consumed);
+      if (paused != hal::IoStatus::kOk) return OutputFailed(paused);
+      if (consumed) return paused;
     }
-    hal::IoStatus status = hal::IoStatus::kOk;
     const motion::TickOutput out = motion_.Tick();
     executed_ += out.commands_done;
     if (out.pen != 0) status = pen.SetPen(out.pen > 0);
@@ -196,7 +230,12 @@ class Device {
   FDSURF_NODISCARD const motion::ValidationWork& validation_work() const {
     return validation_work_;
   }
-  FDSURF_NODISCARD bool Idle() const { return queued_ == 0 && generator_.Idle() && motion_.Idle(); }
+  FDSURF_NODISCARD bool Idle() const {
+    return queued_ == 0 && generator_.Idle() && motion_.Idle() && !homing_.active &&
+           motors_request_ == kNoMotorsRequest;
+  }
+  /// Axes homed (bit a: axis a) since the motors were last disabled.
+  FDSURF_NODISCARD uint8_t homed() const { return homed_; }
 
   // --- The protocol sink (fdsurf/protocol/device_link.h) ------------------
 
@@ -226,8 +265,7 @@ class Device {
       configured_ = true;
     } else {
       if (!configured_) return protocol::ErrorCode::kNotConfigured;
-      const protocol::ErrorCode error =
-          motion::ValidateCommand<kAxes>(command, accepted_config_, detail, &validation_work_);
+      const protocol::ErrorCode error = ValidateQueued(command, detail);
       if (error != protocol::ErrorCode::kNone) return error;
     }
     queue_[(queue_head_ + queued_) % kQueueCapacity] = command;
@@ -240,6 +278,9 @@ class Device {
   FDSURF_NODISCARD uint8_t QueueCapacity() const { return static_cast<uint8_t>(kQueueCapacity); }
   FDSURF_NODISCARD uint32_t TickHz() const { return tick_hz_; }
   FDSURF_NODISCARD uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
+  FDSURF_NODISCARD uint8_t Features() const {
+    return endstops_ != nullptr ? protocol::kFeatureEndstops : 0;
+  }
 
   void FillStatus(protocol::StatusReport* report) const {
     const InterruptLock lock;
@@ -249,6 +290,8 @@ class Device {
       report->state = protocol::DeviceState::kPaused;
     } else if (motion_.Stopping()) {
       report->state = protocol::DeviceState::kStopping;
+    } else if (homing_.active) {
+      report->state = protocol::DeviceState::kHoming;
     } else {
       report->state = Idle() ? protocol::DeviceState::kIdle : protocol::DeviceState::kRunning;
     }
@@ -262,14 +305,20 @@ class Device {
     report->next_seq = link_.next_seq();
     report->executed = executed_;
     report->moves = motion_.moves();
+    const uint8_t endstops = static_cast<uint8_t>(endstops_now_.min_mask | endstops_now_.max_mask);
+    report->flags = static_cast<uint8_t>((enabled_ ? protocol::kStatusFlagMotorsEnabled : 0) |
+                                         homed_ * protocol::kStatusFlagHomedX |
+                                         endstops * protocol::kStatusFlagEndstopX);
   }
 
   /// STOP: the queue is dropped now; the motion decelerates to rest along
   /// its path, then the rest of the buffer is dropped and the pen lifted.
+  /// A homing in progress ends at once (its axis is not homed).
   void Stop() {
     DropQueue();
     const InterruptLock lock;
     EndPause();
+    EndHoming();
     if (motion_.Idle()) {
       FinishStop();
     } else {
@@ -313,6 +362,11 @@ class Device {
     DropQueue();
     const InterruptLock lock;
     EndPause();
+    // The drivers go off: a homing ends and what was homed is forgotten.
+    EndHoming();
+    homed_ = 0;
+    accepted_homed_ = 0;
+    motors_request_ = kNoMotorsRequest;
     // The buffer goes at once; the motion loop's own pen state follows
     // through a pen-up entry, while the outputs are written directly by the
     // next Tick().
@@ -321,7 +375,7 @@ class Device {
   }
 
   /// A new session: as STOP, and the configuration and counters are
-  /// forgotten too.
+  /// forgotten too. Homing is kept: the motors stayed where they were.
   void Reset() {
     Stop();
     const InterruptLock lock;
@@ -352,6 +406,12 @@ class Device {
     pen_servo_down_us_ = 0;
     error_ = protocol::ErrorCode::kNone;
     error_detail_ = 0;
+    homed_ = 0;
+    accepted_homed_ = 0;
+    motors_request_ = kNoMotorsRequest;
+    homing_ = Homing{};
+    endstops_now_ = hal::EndstopState{0, 0};
+    for (int32_t& travel : applied_travel_) travel = 0;
     generator_.Reset(motion_.position(), false);
     pause_ = PausePhase::kNone;
   }
@@ -365,12 +425,13 @@ class Device {
     motion::TickLimits tick;
     const bool converted = motion::ToTickLimits(LimitsOf(config), &tick);
     const InterruptLock lock;
-    if (!motion_.Idle()) return false;
+    if (!motion_.Idle() || motors_request_ != kNoMotorsRequest) return false;
     if (converted) motion_.Configure(tick);
     // Handed to the pen output by the next Tick(), before any pen change.
     pen_servo_up_us_ = config.servo_up_us;
     pen_servo_down_us_ = config.servo_down_us;
     pen_config_pending_ = true;
+    for (int a = 0; a < protocol::kMaxAxes; ++a) applied_travel_[a] = config.travel_steps[a];
     ++executed_;
     return true;
   }
@@ -388,6 +449,9 @@ class Device {
   void DropQueue() {
     queued_ = 0;
     queue_head_ = 0;
+    const InterruptLock lock;
+    // What is homed now is what the next accepted command will find.
+    accepted_homed_ = homed_;
   }
 
   void PopCommand() {
@@ -477,6 +541,240 @@ class Device {
     }
   }
 
+  // ---- Homing and motors (the HOME and MOTORS commands) ----------------
+
+  struct Homing {
+    bool active = false;
+    bool ended = false;    // the main loop has to resynchronise the generator
+    bool backing = false;  // backing off (else searching for the switch)
+    uint8_t axis = 0;
+    uint8_t remaining = 0;  // axes still to home, the current one included
+    uint8_t toward_max = 0;
+    uint32_t rate = 0;
+    uint32_t backoff = 0;
+    uint32_t accumulator = 0;  // += rate per tick; a step each time it reaches tick_hz
+    uint32_t steps_left = 0;   // of the search budget, or of the back-off
+  };
+  static constexpr uint8_t kNoMotorsRequest = 0;
+  static constexpr uint8_t kMotorsOffRequest = 1;
+  static constexpr uint8_t kMotorsOnRequest = 2;
+  static constexpr uint8_t kAxisBits = static_cast<uint8_t>((1u << kAxes) - 1u);
+
+  // Everything but CONFIG: HOME and MOTORS here, motion through
+  // motion::ValidateCommand (and refused while homing is required and the
+  // axes will not all be homed by the time it runs).
+  protocol::ErrorCode ValidateQueued(const protocol::Command& command, uint8_t* detail) {
+    switch (command.type) {
+      case protocol::MessageType::kHome:
+        return ValidateHome(command.body.home, detail);
+      case protocol::MessageType::kMotors:
+        if (!command.body.motors.enabled) accepted_homed_ = 0;
+        return protocol::ErrorCode::kNone;
+      case protocol::MessageType::kPen:
+        break;
+      default:
+        if ((accepted_config_.flags & protocol::kConfigFlagHomingRequired) != 0 &&
+            accepted_homed_ != kAxisBits) {
+          return protocol::ErrorCode::kNotHomed;
+        }
+        break;
+    }
+    return motion::ValidateCommand<kAxes>(command, accepted_config_, detail, &validation_work_);
+  }
+
+  protocol::ErrorCode ValidateHome(const protocol::HomeCommand& home, uint8_t* detail) {
+    const hal::EndstopState fitted =
+        endstops_ != nullptr ? endstops_->fitted() : hal::EndstopState{0, 0};
+    const uint8_t toward_min = static_cast<uint8_t>(home.axes & ~home.toward_max);
+    if ((home.axes & ~kAxisBits) != 0 || (toward_min & ~fitted.min_mask) != 0 ||
+        (home.toward_max & ~fitted.max_mask) != 0) {
+      *detail = protocol::kHomeFieldAxes;
+      return protocol::ErrorCode::kBadField;
+    }
+    if (home.rate > tick_hz_) {
+      *detail = protocol::kHomeFieldRate;
+      return protocol::ErrorCode::kBadField;
+    }
+    for (int a = 0; a < kAxes; ++a) {
+      if ((home.axes >> a & 1u) != 0 &&
+          home.backoff > static_cast<uint32_t>(accepted_config_.travel_steps[a])) {
+        *detail = protocol::kHomeFieldBackoff;
+        return protocol::ErrorCode::kBadField;
+      }
+    }
+    accepted_homed_ = static_cast<uint8_t>(accepted_homed_ | home.axes);
+    return protocol::ErrorCode::kNone;
+  }
+
+  // A HOME at the head of the queue: once the motion is at rest, lifts the
+  // pen if it is down (and waits for that), then hands the homing to
+  // Tick(). True when the homing has started.
+  bool StartHomingAtRest(const protocol::HomeCommand& home) {
+    const InterruptLock lock;
+    if (!motion_.Idle() || motors_request_ != kNoMotorsRequest) return false;
+    if (motion_.pen_down()) {
+      (void)motion_.Push(motion::MakeEntry(motion::EntryKind::kPenUp));
+      return false;
+    }
+    homing_ = Homing{};
+    homing_.active = true;
+    homing_.remaining = home.axes;
+    homing_.toward_max = home.toward_max;
+    homing_.rate = home.rate;
+    homing_.backoff = home.backoff;
+    StartHomingAxis();
+    return true;
+  }
+
+  // The lowest axis left: its search budget is its travel and an eighth.
+  void StartHomingAxis() {
+    uint8_t axis = 0;
+    while ((homing_.remaining >> axis & 1u) == 0) ++axis;
+    const uint32_t travel = static_cast<uint32_t>(applied_travel_[axis]);
+    homing_.axis = axis;
+    homing_.backing = false;
+    homing_.accumulator = 0;
+    homing_.steps_left = travel + (travel >> 3) + 1;
+  }
+
+  // False while Tick() is homing; once it has ended, the path generator
+  // continues from where the homing left the machine.
+  bool FinishHomingAtRest() {
+    const InterruptLock lock;
+    if (homing_.active) return false;
+    if (homing_.ended) {
+      homing_.ended = false;
+      generator_.Reset(motion_.position(), motion_.pen_down());
+    }
+    return true;
+  }
+
+  bool RequestMotorsAtRest(bool enabled) {
+    const InterruptLock lock;
+    if (!motion_.Idle() || motors_request_ != kNoMotorsRequest) return false;
+    motors_request_ = enabled ? kMotorsOnRequest : kMotorsOffRequest;
+    return true;
+  }
+
+  // In Tick(): a MOTORS command's effect, counted as executed.
+  // A homing in progress ends at once (its axis is not homed).
+  void EndHoming() {
+    if (homing_.active) {
+      homing_.active = false;
+      homing_.ended = true;
+    }
+  }
+
+  hal::IoStatus ApplyMotorsRequest(hal::StepDirOutputs& steppers) {
+    const bool enable = motors_request_ == kMotorsOnRequest;
+    motors_request_ = kNoMotorsRequest;
+    ++executed_;
+    if (!enable) homed_ = 0;
+    const hal::IoStatus status = steppers.SetEnabled(enable);
+    enabled_ = enable && status == hal::IoStatus::kOk;
+    return status;
+  }
+
+  hal::IoStatus ReadEndstops() {
+    if (endstops_ == nullptr) return hal::IoStatus::kOk;
+    const hal::IoStatus status = endstops_->Read(&endstops_now_);
+    if (status != hal::IoStatus::kOk) endstops_now_ = hal::EndstopState{0, 0};
+    return status;
+  }
+
+  // One tick of homing: O(1), additions and comparisons only. The axis steps
+  // when the accumulator reaches tick_hz (rate steps per second on average,
+  // no ramp: the rate must be one the motors start at).
+  hal::IoStatus HomingTick(hal::StepDirOutputs& steppers) {
+    homing_.accumulator += homing_.rate;
+    if (homing_.accumulator < tick_hz_) return hal::IoStatus::kOk;
+    homing_.accumulator -= tick_hz_;
+    const uint8_t bit = static_cast<uint8_t>(1u << homing_.axis);
+    const bool toward_max = (homing_.toward_max & bit) != 0;
+    const uint8_t switches = toward_max ? endstops_now_.max_mask : endstops_now_.min_mask;
+    const bool triggered = (switches & bit) != 0;
+    if (!homing_.backing) {
+      if (triggered) {
+        homing_.backing = true;
+        homing_.steps_left = homing_.backoff;
+        return hal::IoStatus::kOk;
+      }
+      if (homing_.steps_left == 0) return HomingFailed();
+      --homing_.steps_left;
+      return HomingStep(steppers, toward_max);
+    }
+    if (homing_.steps_left > 0) {
+      --homing_.steps_left;
+      return HomingStep(steppers, !toward_max);
+    }
+    // A back-off of 0 rests on the switch on purpose; any other must release it.
+    if (triggered && homing_.backoff > 0) return HomingFailed();
+    FinishHomingAxis(toward_max);
+    return hal::IoStatus::kOk;
+  }
+
+  hal::IoStatus HomingStep(hal::StepDirOutputs& steppers, bool positive) {
+    const uint8_t bit = static_cast<uint8_t>(1u << homing_.axis);
+    hal::IoStatus status = hal::IoStatus::kOk;
+    if (!enabled_) {
+      status = steppers.SetEnabled(true);
+      enabled_ = status == hal::IoStatus::kOk;
+    }
+    const uint8_t directions =
+        static_cast<uint8_t>(positive ? (directions_ & ~bit) : (directions_ | bit));
+    if (status == hal::IoStatus::kOk && directions != directions_) {
+      status = steppers.SetDirections(directions);
+      directions_ = directions;
+    }
+    if (status == hal::IoStatus::kOk) status = steppers.Step(bit);
+    if (status != hal::IoStatus::kOk) return status;
+    int32_t position[protocol::kMaxAxes];
+    for (int a = 0; a < protocol::kMaxAxes; ++a) position[a] = motion_.position()[a];
+    position[homing_.axis] += positive ? 1 : -1;
+    motion_.set_position(position);
+    return hal::IoStatus::kOk;
+  }
+
+  void FinishHomingAxis(bool toward_max) {
+    int32_t position[protocol::kMaxAxes];
+    for (int a = 0; a < protocol::kMaxAxes; ++a) position[a] = motion_.position()[a];
+    position[homing_.axis] = toward_max ? applied_travel_[homing_.axis] : 0;
+    motion_.set_position(position);
+    const uint8_t bit = static_cast<uint8_t>(1u << homing_.axis);
+    homed_ = static_cast<uint8_t>(homed_ | bit);
+    homing_.remaining = static_cast<uint8_t>(homing_.remaining & ~bit);
+    if (homing_.remaining != 0) {
+      StartHomingAxis();
+      return;
+    }
+    homing_.active = false;
+    homing_.ended = true;
+    ++executed_;
+  }
+
+  // In Tick(): the switch never triggered (or never released). The queue
+  // is dropped by the next Fill(), as after any fault.
+  hal::IoStatus HomingFailed() {
+    error_ = protocol::ErrorCode::kHomingFailed;
+    error_detail_ = homing_.axis;
+    fault_ = true;
+    homing_.active = false;
+    homing_.ended = true;
+    return hal::IoStatus::kOk;
+  }
+
+  // In Tick(): an output (or input) failed; Fill() drops the queue.
+  hal::IoStatus OutputFailed(hal::IoStatus status) {
+    outputs_failed_ = true;
+    error_ = protocol::ErrorCode::kOutputFailed;
+    error_detail_ = static_cast<uint8_t>(status);
+    fault_ = true;
+    homing_.active = false;
+    homing_.ended = true;
+    motion_.Stop();
+    return status;
+  }
+
   // A fault found by the main loop (Tick() records its own).
   void Fault(protocol::ErrorCode error, uint8_t detail) {
     DropQueue();
@@ -519,6 +817,13 @@ class Device {
   bool pen_lifted_by_pause_ = false;  // the pen is up only because of the pause
   bool lower_pending_ = false;        // kLowering: the pen is yet to be lowered
   bool halt_outputs_ = false;         // HALT: pen up and drivers off on the next tick
+  hal::EndstopInputs* endstops_ = nullptr;
+  hal::EndstopState endstops_now_ = {0, 0};
+  Homing homing_;
+  int32_t applied_travel_[protocol::kMaxAxes] = {0, 0, 0};
+  uint8_t homed_ = 0;
+  uint8_t accepted_homed_ = 0;
+  uint8_t motors_request_ = kNoMotorsRequest;
 };
 
 }  // namespace device

@@ -29,7 +29,7 @@ constexpr int32_t kMaxTravelSteps = (int32_t{1} << 30) - 1;
 /// kMaxPatchSteps + 1 lines.
 constexpr uint16_t kMaxLines = kMaxPatchSteps + 1;
 /// The largest ErrorCode value this version defines.
-constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kUnknownSession);
+constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kHomingFailed);
 
 /// Field indices (DecodeResult::field and ErrorReply::detail for kBadField).
 /// For kBadLength the index is that of the field cut short, or the number of
@@ -48,7 +48,8 @@ constexpr uint8_t kConfigFieldAccel = 8;
 constexpr uint8_t kConfigFieldPenDelay = 9;
 constexpr uint8_t kConfigFieldServoUp = 14;
 constexpr uint8_t kConfigFieldServoDown = 15;
-constexpr uint8_t kConfigFieldCount = 16;
+constexpr uint8_t kConfigFieldFlags = 16;
+constexpr uint8_t kConfigFieldCount = 17;
 // kPatch: geometry[axis].g[i][j] is field kPatchFieldGeometry + 16·axis + 4·i + j.
 constexpr uint8_t kPatchFieldBasis = 0;
 constexpr uint8_t kPatchFieldDims = 1;
@@ -68,6 +69,15 @@ constexpr uint8_t kMoveFieldCount = 3;
 // kPen
 constexpr uint8_t kPenFieldDown = 0;
 constexpr uint8_t kPenFieldCount = 1;
+// kHome
+constexpr uint8_t kHomeFieldAxes = 0;
+constexpr uint8_t kHomeFieldTowardMax = 1;
+constexpr uint8_t kHomeFieldRate = 2;
+constexpr uint8_t kHomeFieldBackoff = 3;
+constexpr uint8_t kHomeFieldCount = 4;
+// kMotors
+constexpr uint8_t kMotorsFieldEnabled = 0;
+constexpr uint8_t kMotorsFieldCount = 1;
 // kHelloReply
 constexpr uint8_t kHelloReplyFieldVersion = 0;
 constexpr uint8_t kHelloReplyFieldNextSeq = 1;
@@ -76,7 +86,8 @@ constexpr uint8_t kHelloReplyFieldQueueCapacity = 3;
 constexpr uint8_t kHelloReplyFieldTickHz = 4;
 constexpr uint8_t kHelloReplyFieldMaxAxes = 5;
 constexpr uint8_t kHelloReplyFieldMaxLines = 6;
-constexpr uint8_t kHelloReplyFieldCount = 7;
+constexpr uint8_t kHelloReplyFieldFeatures = 7;
+constexpr uint8_t kHelloReplyFieldCount = 8;
 // kStatusReport: position[axis] is field kStatusFieldPosition + axis.
 constexpr uint8_t kStatusFieldState = 0;
 constexpr uint8_t kStatusFieldError = 1;
@@ -88,7 +99,8 @@ constexpr uint8_t kStatusFieldCredits = 8;
 constexpr uint8_t kStatusFieldNextSeq = 9;
 constexpr uint8_t kStatusFieldExecuted = 10;
 constexpr uint8_t kStatusFieldMoves = 11;
-constexpr uint8_t kStatusFieldCount = 12;
+constexpr uint8_t kStatusFieldFlags = 12;
+constexpr uint8_t kStatusFieldCount = 13;
 // kAck
 constexpr uint8_t kAckFieldNextSeq = 0;
 constexpr uint8_t kAckFieldCredits = 1;
@@ -161,7 +173,7 @@ size_t EncodeError(const ErrorReply& error, uint8_t* out, size_t capacity, uint3
 
 // ---- Decoding. All take a CRC-checked frame from FrameDecoder.
 
-/// A sequenced command (kConfig..kPen). Errors: kUnknownType (not a known
+/// A sequenced command (kConfig..kMotors). Errors: kUnknownType (not a known
 /// sequenced type), kBadLength, kBadField. out->type and out->seq are the
 /// frame's. Geometry of unused axes is zeroed.
 DecodeResult DecodeCommand(const Frame& frame, Command* out);

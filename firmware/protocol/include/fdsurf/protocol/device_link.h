@@ -36,6 +36,7 @@
 //   uint8_t QueueCapacity() const;  // command slots in all, >= 1
 //   uint32_t TickHz() const;        // motion ticks per second
 //   uint8_t MaxAxes() const;        // 2 or 3
+//   uint8_t Features() const;       // HelloReply::features (kFeature... bits)
 //   // Everything but next_seq (the link sets that).
 //   void FillStatus(protocol::StatusReport* report) const;
 //   void Stop();   // STOP: stop motion, drop the queue
@@ -240,6 +241,7 @@ class DeviceLink {
     reply.tick_hz = sink_->TickHz();
     reply.max_axes = sink_->MaxAxes();
     reply.max_lines = kMaxLines;
+    reply.features = sink_->Features();
     Emit(EncodeHelloReply(frame.seq, reply, out_ + out_end_, kOutputCapacity - out_end_, session_));
   }
 

@@ -21,7 +21,8 @@ namespace protocol {
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
 /// the session id (Hello::session), folded into the CRC of every other frame.
 /// Version 3 adds PAUSE, RESUME and HALT, and the machine's pen hardware and
-/// limits in CONFIG (issue 15).
+/// limits in CONFIG, and homing (HOME, MOTORS, MachineConfig::flags, the
+/// status flags and HELLO_REPLY's features): issue 15, docs/protocol.md.
 constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
@@ -49,6 +50,8 @@ enum class MessageType : uint8_t {
   kCurve = 0x12,   ///< CurveCommand
   kMove = 0x13,    ///< MoveCommand
   kPen = 0x14,     ///< PenCommand
+  kHome = 0x15,    ///< HomeCommand
+  kMotors = 0x16,  ///< MotorsCommand
 
   kHelloReply = 0x81,
   kStatusReport = 0x82,
@@ -101,7 +104,15 @@ struct MachineConfig {
   /// in 500..2500 (hal/pwm.h ServoPen).
   uint16_t servo_up_us;
   uint16_t servo_down_us;
+  /// kConfigFlag... bits; the others must be 0.
+  uint8_t flags;
 };
+
+/// MachineConfig::flags: PATCH, CURVE and MOVE are refused with kNotHomed
+/// until every configured axis has been homed (HOME) since the motors were
+/// last disabled.
+constexpr uint8_t kConfigFlagHomingRequired = 0x01;
+constexpr uint8_t kConfigKnownFlags = kConfigFlagHomingRequired;
 
 /// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a
 /// step-exact adaptive forward-difference path within tolerance, with
@@ -148,6 +159,30 @@ struct PenCommand {
   bool down;
 };
 
+/// Homes the axes in `axes` (bit a: axis a), one after the other in axis
+/// order, once everything before it has been executed: each moves towards
+/// its endstop (the max end for the axes in `toward_max`, else the min end)
+/// at `rate` steps/s until the switch triggers, backs off `backoff` steps,
+/// and takes that point as its position 0 (min) or travel_steps (max).
+/// The device refuses it with kBadField unless axes ≠ 0 and ⊆ the
+/// configured axes, toward_max ⊆ axes, 1 ≤ rate ≤ tick_hz and backoff ≤ the
+/// travel of every homed axis; it fails with kHomingFailed (detail = axis)
+/// when a switch does not trigger within the axis's travel plus a margin or
+/// is still triggered after a back-off other than 0.
+struct HomeCommand {
+  uint8_t axes;
+  uint8_t toward_max;
+  uint32_t rate;
+  uint32_t backoff;
+};
+
+/// Enables (true) or disables the stepper drivers once everything before it
+/// has been executed. Disabling forgets homing: the carriage may be moved by
+/// hand.
+struct MotorsCommand {
+  bool enabled;
+};
+
 /// A decoded sequenced command.
 struct Command {
   MessageType type;
@@ -159,6 +194,8 @@ struct Command {
     CurveCommand curve;
     MoveCommand move;
     PenCommand pen;
+    HomeCommand home;
+    MotorsCommand motors;
   } body;
 };
 
@@ -178,6 +215,8 @@ enum class ErrorCode : uint8_t {
   kStopped = 11,            ///< a command arrived while a stop was in progress
   kOutputFailed = 12,       ///< a step or pen output failed (status: detail = hal::IoStatus)
   kUnknownSession = 13,     ///< a resume HELLO for a session the device does not have
+  kNotHomed = 14,           ///< motion refused: the configuration requires homing first
+  kHomingFailed = 15,       ///< an endstop did not trigger (or release); detail = axis
 };
 
 /// A short, stable name ("bad length", ...).
@@ -190,6 +229,7 @@ enum class DeviceState : uint8_t {
   kStopping = 2,  ///< decelerating after kStop
   kFault = 3,     ///< an execution error; `error` says which
   kPaused = 4,    ///< decelerating to, or holding at, a pause (kPause)
+  kHoming = 5,    ///< executing a HOME command
 };
 
 struct HelloReply {
@@ -204,7 +244,12 @@ struct HelloReply {
   /// Axes the device drives; largest grid it evaluates.
   uint8_t max_axes;
   uint16_t max_lines;
+  /// kFeature... bits: what the device was built with.
+  uint8_t features;
 };
+
+/// HelloReply::features: the device reads endstop inputs (HOME can work).
+constexpr uint8_t kFeatureEndstops = 0x01;
 
 struct StatusReport {
   DeviceState state;
@@ -221,7 +266,16 @@ struct StatusReport {
   uint32_t executed;
   /// Unit moves (ticks that stepped) since the session began.
   uint32_t moves;
+  /// kStatusFlag... bits: motors enabled, axes homed, endstops triggered.
+  uint8_t flags;
 };
+
+/// StatusReport::flags. Axis a's homed bit is kStatusFlagHomedX << a, its
+/// endstop bit (either of its switches triggered now) kStatusFlagEndstopX << a.
+constexpr uint8_t kStatusFlagMotorsEnabled = 0x01;
+constexpr uint8_t kStatusFlagHomedX = 0x02;
+constexpr uint8_t kStatusFlagEndstopX = 0x10;
+constexpr uint8_t kStatusKnownFlags = 0x7F;
 
 struct Ack {
   /// Cumulative: every seq before this one is accepted.

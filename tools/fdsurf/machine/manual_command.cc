@@ -1,0 +1,398 @@
+// SPDX-License-Identifier: MIT
+#include "manual_command.h"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../cli_options.h"
+#include "../runners/runner.h"
+#include "../runners/serial_session.h"
+#include "../stream_command.h"
+#include "fdsurf/hal/serial_transport.h"
+#include "fdsurf/host/errors.h"
+#include "fdsurf/host/text.h"
+#include "fdsurf/sim/plotter.h"
+#include "profile.h"
+
+namespace fdsurf::host {
+namespace {
+
+const char* const kAxisLetters = "xyz";
+
+// The settings `stream` would use: its options given the profile's values
+// and then the command line's --device and --units.
+struct Settings {
+  StreamOptions stream;
+  MachineOptions machine;
+  int axes = 2;
+  double step = 0;  // in stream.units
+};
+
+void GiveOption(CLI::App* command, const std::string& flag, const std::string& value) {
+  CLI::Option* option = command->get_option(flag);
+  option->add_result(value);
+  option->run_callback();
+}
+
+Settings Resolve(const ManualOptions& o) {
+  CLI::App app;
+  Settings s;
+  CLI::App* stream = app.add_subcommand("stream");
+  AddStreamOptions(stream, &s.stream);
+  if (!o.units.empty()) GiveOption(stream, "--units", o.units);
+  if (!o.device.empty()) GiveOption(stream, "--device", o.device);
+  const std::pair<const char*, const std::string*> given[] = {{"--step", &o.step},
+                                                              {"--travel", &o.travel},
+                                                              {"--speed", &o.speed},
+                                                              {"--accel", &o.accel},
+                                                              {"--tick-hz", &o.tick_hz}};
+  for (const auto& [flag, value] : given) {
+    if (!value->empty()) GiveOption(stream, flag, *value);
+  }
+  ApplyMachineOption(o.machine, stream);
+  s.machine = StreamMachine(s.stream);
+  if (!(s.machine.travel[0] > 0)) {
+    throw InputError(
+        "machine commands need the machine's travel: give 'travel' in the profile "
+        "(--machine) or --travel WxH on the command line");
+  }
+  s.axes = s.machine.travel[2] > 0 ? 3 : 2;
+  s.step = s.machine.step.value();
+  return s;
+}
+
+std::int32_t ToSteps(double length, double step) {
+  return static_cast<std::int32_t>(std::floor(length / step + 1e-9));
+}
+
+protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz, bool require_homing) {
+  protocol::MachineConfig config{};
+  config.axes = static_cast<std::uint8_t>(s.axes);
+  const double meters = s.step * (s.stream.units == "in" ? 0.0254 : 0.001);
+  for (int a = 0; a < s.axes; ++a) {
+    config.steps_per_meter[a] = static_cast<std::uint32_t>(std::lround(1 / meters));
+    config.travel_steps[a] = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], s.step);
+  }
+  const double rate = std::floor(s.machine.speed / s.step);
+  config.max_rate = static_cast<std::uint32_t>(std::clamp(rate, 1.0, double(tick_hz)));
+  config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / s.step)));
+  config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
+  config.flags = require_homing ? protocol::kConfigFlagHomingRequired : 0;
+  return config;
+}
+
+// One device connection: HELLO's answer, and jobs run to rest.
+class Connection {
+ public:
+  virtual ~Connection() = default;
+  virtual protocol::HelloReply Hello() = 0;
+  /// Runs `commands` until executed and at rest: the status then.
+  virtual protocol::StatusReport Run(const std::vector<protocol::Command>& commands) = 0;
+  /// What to add to the output after a job (the simulator's view).
+  virtual std::string Note(const Settings& /*s*/) { return ""; }
+};
+
+StreamJob JobOf(const std::vector<protocol::Command>& commands) {
+  StreamJob job;
+  job.commands = commands;
+  for (const protocol::Command& command : commands) {
+    job.labels.push_back(std::string("machine ") +
+                         (command.type == protocol::MessageType::kConfig ? "config" : "command"));
+  }
+  return job;
+}
+
+class SerialConnection final : public Connection {
+ public:
+  explicit SerialConnection(const StreamOptions& o) {
+    hal::SerialSpec spec;
+    std::string error;
+    if (!hal::ParseSerialDevice(o.device, &spec, &error)) throw InputError("--device: " + error);
+    if (spec.automatic) throw InputError("--device serial:auto: name the port, serial:PATH");
+    bool interrupted = false;
+    auto session = ProbeSerialPort(spec.path, spec.baud, Milliseconds(o.connect_timeout_s), o.quiet,
+                                   &error, &interrupted);
+    if (!session) throw DeviceError(error);
+    session_ = std::move(*session);
+  }
+  protocol::HelloReply Hello() override { return *session_.loop->link().hello(); }
+  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
+    ProgressLine progress(false);
+    if (session_.loop->Run(JobOf(commands), &progress) != 0) {
+      throw DeviceError("interrupted; the device was stopped");
+    }
+    return *session_.loop->link().status();
+  }
+
+ private:
+  SerialSession session_;
+};
+
+// The simulated plotter: its carriage starts a third of X's travel and a
+// quarter of Y's (and of Z's) from the min switches.
+class SimConnection final : public Connection {
+ public:
+  SimConnection(const StreamOptions& o, const Settings& s) {
+    sim::PlotterOptions options;
+    options.axes = s.axes;
+    if (o.tick_hz != 0) options.tick_hz = o.tick_hz;
+    options.endstops = true;
+    for (int a = 0; a < s.axes; ++a) {
+      const std::int32_t travel = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], s.step);
+      options.endstop_options.start_offset[a] = a == 0 ? travel / 3 : travel / 4;
+    }
+    plotter_ = std::make_unique<sim::SimulatedPlotter>(options);
+  }
+  protocol::HelloReply Hello() override {
+    protocol::HelloReply hello{};
+    hello.tick_hz = plotter_->options().tick_hz;
+    hello.features = protocol::kFeatureEndstops;
+    return hello;
+  }
+  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
+    HostLink link(LinkOptions());
+    for (const protocol::Command& command : commands) {
+      const protocol::DecodeResult result = link.Enqueue(command);
+      if (!result.ok()) throw EngineError("machine command: cannot be sent");
+    }
+    const sim::RunResult result = plotter_->Run(link, 3'600'000'000ull);
+    if (!result.finished) throw DeviceError("sim: " + DecodeDeviceError(result.error));
+    return *link.status();
+  }
+  std::string Note(const Settings& s) override {
+    const hal::SimEndstops& switches = *plotter_->endstops();
+    std::string note = "sim: the carriage stands";
+    for (int a = 0; a < s.axes; ++a) {
+      note += std::string(a == 0 ? " " : ", ") + kAxisLetters[a] + " " +
+              FormatNumber(static_cast<double>(switches.real_position(a)) * s.step);
+    }
+    return note + " " + s.stream.units + " from its min switches (it started at " +
+           FormatNumber(static_cast<double>(switches.real_position(0) - plotter_->position()[0]) *
+                        s.step) +
+           ", " +
+           FormatNumber(static_cast<double>(switches.real_position(1) - plotter_->position()[1]) *
+                        s.step) +
+           ")";
+  }
+
+ private:
+  std::unique_ptr<sim::SimulatedPlotter> plotter_;
+};
+
+std::unique_ptr<Connection> Connect(const Settings& s) {
+  const std::string& device = s.stream.device;
+  if (device == "sim") return std::make_unique<SimConnection>(s.stream, s);
+  if (device.rfind("serial:", 0) == 0) return std::make_unique<SerialConnection>(s.stream);
+  throw InputError("--device " + device +
+                   ": machine commands run on sim and serial:PATH devices so far");
+}
+
+std::string Where(const Settings& s, const protocol::StatusReport& r) {
+  std::string text = "position";
+  std::string steps;
+  for (int a = 0; a < s.axes; ++a) {
+    text += std::string(a == 0 ? " " : ", ") + kAxisLetters[a] + " " +
+            FormatNumber(r.position[a] * s.step);
+    steps += (a == 0 ? "" : ", ") + std::to_string(r.position[a]);
+  }
+  text += " " + s.stream.units + " (steps " + steps + "); pen " + (r.pen_down ? "down" : "up") +
+          "; motors " + ((r.flags & protocol::kStatusFlagMotorsEnabled) != 0 ? "on" : "off");
+  std::string homed;
+  std::string endstops;
+  for (int a = 0; a < s.axes; ++a) {
+    if ((r.flags & (protocol::kStatusFlagHomedX << a)) != 0) homed += kAxisLetters[a];
+    if ((r.flags & (protocol::kStatusFlagEndstopX << a)) != 0) endstops += kAxisLetters[a];
+  }
+  return text + "; homed " + (homed.empty() ? "none" : homed) + "; endstops triggered " +
+         (endstops.empty() ? "none" : endstops);
+}
+
+std::uint8_t AxisMask(const std::string& letters, int axes, const char* flag) {
+  std::uint8_t mask = 0;
+  for (const char c : letters) {
+    const char* at = std::strchr(kAxisLetters, c);
+    if (at == nullptr || c == '\0' || at - kAxisLetters >= axes) {
+      throw InputError(std::string(flag) + ": '" + letters + "' is not a set of the axes " +
+                       std::string(kAxisLetters, static_cast<std::size_t>(axes)));
+    }
+    mask = static_cast<std::uint8_t>(mask | 1u << (at - kAxisLetters));
+  }
+  if (mask == 0) throw InputError(std::string(flag) + ": name at least one axis");
+  return mask;
+}
+
+protocol::Command HomeOf(const ManualOptions& o, const Settings& s,
+                         const protocol::MachineConfig& config, std::uint32_t tick_hz) {
+  protocol::Command command;
+  command.type = protocol::MessageType::kHome;
+  protocol::HomeCommand& home = command.body.home;
+  home.axes =
+      AxisMask(o.axes.empty() ? std::string(kAxisLetters, s.axes) : o.axes, s.axes, "--axes");
+  if (!o.toward.empty() && o.toward != "min" && o.toward != "max") {
+    throw InputError("--toward: '" + o.toward + "' is not min or max");
+  }
+  home.toward_max = o.toward == "max" ? home.axes : 0;
+  const double rate = o.rate ? *o.rate : DefaultIn(5, s.stream.units);
+  const double backoff = o.backoff ? *o.backoff : DefaultIn(1, s.stream.units);
+  const double rate_steps = std::floor(rate / s.step);
+  if (!(rate_steps >= 1 && rate_steps <= tick_hz)) {
+    throw InputError("--rate: " + FormatNumber(rate) + " " + s.stream.units +
+                     "/s is not between one step per second and the device's " +
+                     std::to_string(tick_hz) + " steps/s");
+  }
+  home.rate = static_cast<std::uint32_t>(rate_steps);
+  const std::int32_t backoff_steps = ToSteps(backoff, s.step);
+  if (backoff < 0 || backoff_steps > config.travel_steps[0]) {
+    throw InputError("--backoff: " + FormatNumber(backoff) + " " + s.stream.units +
+                     " is not within the travel");
+  }
+  home.backoff = static_cast<std::uint32_t>(backoff_steps);
+  return command;
+}
+
+}  // namespace
+
+namespace {
+
+double NumberArg(const std::string& action, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(value)) return value;
+  } catch (const std::exception&) {
+  }
+  throw InputError("machine " + action + ": '" + text + "' is not a number");
+}
+
+// jog and goto: the target in steps, refused outside [0, travel].
+protocol::Command MoveOf(const std::string& action, const ManualOptions& o, const Settings& s,
+                         const protocol::MachineConfig& config, const protocol::StatusReport& now) {
+  const std::size_t given = o.args.size();
+  if (given < 2 || given > static_cast<std::size_t>(s.axes)) {
+    throw InputError("machine " + action + ": give " + (action == "jog" ? "DX DY" : "X Y") +
+                     (s.axes == 3 ? " [DZ]" : "") + " in " + s.stream.units);
+  }
+  protocol::Command command;
+  command.type = protocol::MessageType::kMove;
+  for (std::int32_t& target : command.body.move.target) target = 0;
+  for (int a = 0; a < s.axes; ++a) {
+    const bool has = static_cast<std::size_t>(a) < given;
+    const double value = has ? NumberArg(action, o.args[static_cast<std::size_t>(a)]) : 0;
+    const double steps = action == "jog" ? now.position[a] + std::round(value / s.step)
+                         : has           ? std::round(value / s.step)
+                                         : now.position[a];
+    if (!(steps >= 0 && steps <= config.travel_steps[a])) {
+      throw InputError("machine " + action + ": the target " + kAxisLetters[a] + " " +
+                       FormatNumber(steps * s.step) + " " + s.stream.units +
+                       " is outside the travel 0.." +
+                       FormatNumber(config.travel_steps[a] * s.step) + " " + s.stream.units);
+    }
+    command.body.move.target[a] = static_cast<std::int32_t>(steps);
+  }
+  return command;
+}
+
+// pen up|down, motors on|off.
+protocol::Command SwitchOf(const std::string& action, const ManualOptions& o) {
+  const char* on = action == "pen" ? "down" : "on";
+  const char* off = action == "pen" ? "up" : "off";
+  if (o.args.size() != 1 || (o.args[0] != on && o.args[0] != off)) {
+    throw InputError("machine " + action + ": give " + on + " or " + off);
+  }
+  protocol::Command command;
+  command.type = action == "pen" ? protocol::MessageType::kPen : protocol::MessageType::kMotors;
+  if (action == "pen") {
+    command.body.pen.down = o.args[0] == on;
+  } else {
+    command.body.motors.enabled = o.args[0] == on;
+  }
+  return command;
+}
+
+int Execute(const std::string& action, const ManualOptions& o, const Settings& s) {
+  std::unique_ptr<Connection> connection = Connect(s);
+  const protocol::HelloReply hello = connection->Hello();
+  protocol::Command config;
+  config.type = protocol::MessageType::kConfig;
+  config.body.config = ConfigOf(s, hello.tick_hz, o.require_homing);
+  std::vector<protocol::Command> commands = {config};
+  if (action == "home") {
+    if ((hello.features & protocol::kFeatureEndstops) == 0) {
+      throw DeviceError(s.stream.device + ": the device has no endstop inputs (HELLO features)");
+    }
+    commands.push_back(HomeOf(o, s, config.body.config, hello.tick_hz));
+  } else if (action == "jog" || action == "goto") {
+    const protocol::StatusReport now = connection->Run(commands);
+    commands.push_back(MoveOf(action, o, s, config.body.config, now));
+  } else if (action == "pen" || action == "motors") {
+    commands.push_back(SwitchOf(action, o));
+  } else if (!o.args.empty()) {
+    throw InputError("machine where: takes no arguments");
+  }
+  const protocol::StatusReport report = connection->Run(commands);
+  const std::string note = connection->Note(s);
+  if (!note.empty() && !o.quiet) std::printf("%s\n", note.c_str());
+  std::printf("%s\n", Where(s, report).c_str());
+  return 0;
+}
+
+}  // namespace
+
+void AddManualCommands(CLI::App* machine, ManualOptions* options, std::string* action) {
+  const std::pair<const char*, const char*> commands[] = {
+      {"home", "Home the axes against their endstops (HOME)."},
+      {"jog", "Move by DX DY [DZ] (--units) from where the machine is."},
+      {"goto", "Move to X Y [Z] (--units), within the travel."},
+      {"pen", "Put the pen up or down."},
+      {"motors", "Switch the stepper drivers off (forgets homing) or on."},
+      {"where", "Print the position, pen, motors, homing and endstops."}};
+  for (const auto& [name, help] : commands) {
+    CLI::App* command = machine->add_subcommand(name, help);
+    AddMachineOption(command, &options->machine);
+    command->add_option("--device", options->device, "the device, as stream's --device");
+    command->add_option("--units", options->units, "units of the arguments and the output")
+        ->check(CLI::IsMember({"mm", "in"}));
+    command->add_flag("--quiet,-q", options->quiet, "only the final position");
+    command->add_option("--step", options->step, "as stream's --step");
+    command->add_option("--travel", options->travel, "as stream's --travel (WxH[xD])");
+    command->add_option("--speed", options->speed, "as stream's --speed");
+    command->add_option("--accel", options->accel, "as stream's --accel");
+    command->add_option("--tick-hz", options->tick_hz, "as stream's --tick-hz");
+    command->add_flag("--require-homing", options->require_homing,
+                      "the device refuses motion until homed (CONFIG flag)");
+    if (std::string(name) == "home") {
+      command->add_option("--axes", options->axes, "axes to home, e.g. xy (default all)");
+      command->add_option("--toward", options->toward, "min (default) or max");
+      command->add_option("--rate", options->rate, "search speed, --units/s (default 5 mm/s)");
+      command->add_option("--backoff", options->backoff,
+                          "back-off from the switch, --units (default 1 mm)");
+    } else {
+      command->add_option("args", options->args, "arguments");
+    }
+    command->callback([action, command] { *action = command->get_name(); });
+  }
+}
+
+int RunManual(const std::string& action, const ManualOptions& options) {
+  const Settings settings = Resolve(options);
+  try {
+    return Execute(action, options, settings);
+  } catch (const DeviceError& e) {
+    std::string message = e.what();
+    if (message.find("not homed") != std::string::npos) {
+      message += " (run `fdsurf machine home` first)";
+    }
+    std::fprintf(stderr, "fdsurf: error: machine %s: %s\n", action.c_str(), message.c_str());
+    return 3;
+  }
+}
+
+}  // namespace fdsurf::host
