@@ -68,6 +68,12 @@ std::string FieldName(MessageType type, uint8_t index) {
         return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
       }
       const std::array<const char*, 3> rest = {"max_rate", "accel", "pen_delay_ms"};
+      if (index == p::kConfigFieldServoUp) {
+        return "servo_up_us";
+      }
+      if (index == p::kConfigFieldServoDown) {
+        return "servo_down_us";
+      }
       if (index == p::kConfigFieldFlags) {
         return "flags";
       }

@@ -528,6 +528,7 @@ class Device {
     error_detail_ = static_cast<uint8_t>(status);
     fault_ = true;
     EndPause();
+    EndHoming();
     motion_.Stop();
     return status;
   }
@@ -764,17 +765,6 @@ class Device {
   }
 
   // In Tick(): an output (or input) failed; Fill() drops the queue.
-  hal::IoStatus OutputFailed(hal::IoStatus status) {
-    outputs_failed_ = true;
-    error_ = protocol::ErrorCode::kOutputFailed;
-    error_detail_ = static_cast<uint8_t>(status);
-    fault_ = true;
-    homing_.active = false;
-    homing_.ended = true;
-    motion_.Stop();
-    return status;
-  }
-
   // A fault found by the main loop (Tick() records its own).
   void Fault(protocol::ErrorCode error, uint8_t detail) {
     DropQueue();
