@@ -96,8 +96,9 @@ Command JobCommand(uint32_t i, bool small_only = false) {
   c.seq = 0;
   if (i == 0) {
     c.type = MessageType::kConfig;
-    c.body.config =
-        MachineConfig{2, {80000, 80000, 0}, {kMaxTravelSteps, kMaxTravelSteps, 0}, 4000, 20000, 0};
+    c.body.config = MachineConfig{
+        2,    {80000, 80000, 0}, {kMaxTravelSteps, kMaxTravelSteps, 0}, 4000, 20000, 0,
+        4000, {20000, 20000, 0}};
     return c;
   }
   const uint32_t kind = small_only ? i % 2 : i % 7;
@@ -733,7 +734,7 @@ TEST(HostLink, VersionMismatchFails) {
                            reply.size()));
   link.OnBytes(reply.data(), reply.size(), 10);
   ASSERT_TRUE(link.Failed());
-  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host 2");
+  EXPECT_EQ(link.error(), "protocol version mismatch: device speaks 1, host 3");
 }
 
 TEST(HostLink, StopIsSentUntilAcknowledged) {
@@ -988,7 +989,8 @@ Command Config(uint32_t max_rate) {
   Command c;
   c.type = MessageType::kConfig;
   c.seq = 0;
-  c.body.config = MachineConfig{2, {80000, 80000, 0}, {100000, 100000, 0}, max_rate, 20000, 0};
+  c.body.config = MachineConfig{2, {80000, 80000, 0}, {100000, 100000, 0}, max_rate, 20000,
+                                0, max_rate,          {20000, 20000, 0}};
   return c;
 }
 Command Move(int32_t x, int32_t y) {

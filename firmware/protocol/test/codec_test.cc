@@ -55,7 +55,8 @@ Command Config() {
   Command c;
   c.type = MessageType::kConfig;
   c.seq = 0;
-  c.body.config = MachineConfig{2, {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150};
+  c.body.config = MachineConfig{2,    {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150,
+                                6000, {30000, 25000, 0}};
   return c;
 }
 
@@ -140,6 +141,7 @@ TEST(Codec, CommandRoundTrips) {
   config3.body.config.axes = 3;
   config3.body.config.steps_per_meter[2] = 400000;
   config3.body.config.travel_steps[2] = kMaxTravelSteps;
+  config3.body.config.axis_accel[2] = 0xFFFFFFFFu;
   ExpectRoundTrip(config3);
   for (uint64_t salt = 0; salt < 50; ++salt) {
     ExpectRoundTrip(Patch(2, salt));
@@ -230,6 +232,18 @@ TEST(CodecValidation, Config) {
                 bad, 6);  // Z used, travel 0
   ExpectRefused(with([](MachineConfig* m) { m->max_rate = 0; }), bad, kConfigFieldMaxRate);
   ExpectRefused(with([](MachineConfig* m) { m->accel = 0; }), bad, kConfigFieldAccel);
+  ExpectRefused(with([](MachineConfig* m) { m->travel_rate = 0; }), bad, kConfigFieldTravelRate);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[0] = 0; }), bad, kConfigFieldAxisAccel);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[1] = 0; }), bad,
+                kConfigFieldAxisAccel + 1);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[2] = 7; }), bad,
+                kConfigFieldAxisAccel + 2);  // unused
+  ExpectRefused(with([](MachineConfig* m) {
+                  m->axes = 3;
+                  m->steps_per_meter[2] = 1;
+                  m->travel_steps[2] = 10;
+                }),
+                bad, kConfigFieldAxisAccel + 2);  // Z used, no limit
 }
 
 TEST(CodecValidation, Patch) {
@@ -322,11 +336,15 @@ TEST(CodecValidation, ExactLength) {
   const Bytes pen = {1, 0};
   EXPECT_EQ(DecodeCommand(BodyFrame(MessageType::kPen, pen), &out).field, kPenFieldCount);
   Bytes config_short = CommandBody(Config());
-  ASSERT_EQ(config_short.size(), 35u);
-  config_short.pop_back();  // pen_delay_ms cut short
+  ASSERT_EQ(config_short.size(), 51u);
+  config_short.pop_back();  // axis_accel[z] cut short
   const DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
-  EXPECT_EQ(r.field, kConfigFieldPenDelay);
+  EXPECT_EQ(r.field, kConfigFieldAxisAccel + 2);
+  config_short.resize(35);  // a version 2 config: ends after pen_delay_ms
+  const DecodeResult v2 = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
+  EXPECT_EQ(v2.code, ErrorCode::kBadLength);
+  EXPECT_EQ(v2.field, kConfigFieldTravelRate);
   const Bytes patch_cut = {2, 2, 2, 0, 0, 0, 1, 0, 0, 0, 0, 5};  // one of 32 geometry values
   const DecodeResult p = DecodeCommand(BodyFrame(MessageType::kPatch, patch_cut), &out);
   EXPECT_EQ(p.code, ErrorCode::kBadLength);

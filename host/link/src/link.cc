@@ -57,9 +57,12 @@ std::string FieldName(MessageType type, uint8_t index) {
       if (index >= p::kConfigFieldTravel && index < p::kConfigFieldMaxRate) {
         return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
       }
-      const std::array<const char*, 3> rest = {"max_rate", "accel", "pen_delay_ms"};
-      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldCount) {
+      const std::array<const char*, 4> rest = {"max_rate", "accel", "pen_delay_ms", "travel_rate"};
+      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldAxisAccel) {
         return rest[index - p::kConfigFieldMaxRate];
+      }
+      if (index >= p::kConfigFieldAxisAccel && index < p::kConfigFieldCount) {
+        return "axis_accel[" + axis(index - p::kConfigFieldAxisAccel) + "]";
       }
       break;
     }

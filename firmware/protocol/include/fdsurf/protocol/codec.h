@@ -46,7 +46,9 @@ constexpr uint8_t kConfigFieldTravel = 4;         // 4..6
 constexpr uint8_t kConfigFieldMaxRate = 7;
 constexpr uint8_t kConfigFieldAccel = 8;
 constexpr uint8_t kConfigFieldPenDelay = 9;
-constexpr uint8_t kConfigFieldCount = 10;
+constexpr uint8_t kConfigFieldTravelRate = 10;
+constexpr uint8_t kConfigFieldAxisAccel = 11;  // 11..13
+constexpr uint8_t kConfigFieldCount = 14;
 // kPatch: geometry[axis].g[i][j] is field kPatchFieldGeometry + 16·axis + 4·i + j.
 constexpr uint8_t kPatchFieldBasis = 0;
 constexpr uint8_t kPatchFieldDims = 1;

@@ -20,7 +20,7 @@ namespace protocol {
 
 /// Protocol version spoken by this code; HELLO carries it. Version 2 adds
 /// the session id (Hello::session), folded into the CRC of every other frame.
-constexpr uint8_t kProtocolVersion = 2;
+constexpr uint8_t kProtocolVersion = 3;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -80,12 +80,21 @@ struct MachineConfig {
   uint32_t steps_per_meter[kMaxAxes];
   /// Each axis moves within [0, travel_steps], 1 ≤ travel_steps < 2^30.
   int32_t travel_steps[kMaxAxes];
-  /// Path speed limit in steps per second, 1 ≤ max_rate ≤ the device's tick rate.
+  /// Path speed limit with the pen down, steps per second,
+  /// 1 ≤ max_rate ≤ the device's tick rate.
   uint32_t max_rate;
   /// Path acceleration limit in steps per second², ≥ 1.
   uint32_t accel;
   /// Rest after every pen change before motion resumes, milliseconds.
   uint16_t pen_delay_ms;
+  /// Path speed limit with the pen up (travel), steps per second,
+  /// 1 ≤ travel_rate ≤ the device's tick rate.
+  uint32_t travel_rate;
+  /// Each axis's acceleration limit, steps per second²: ≥ 1 for used axes,
+  /// 0 for unused ones. `accel` stays the limit along the path; the device
+  /// also keeps every axis's share, the centripetal part included, within
+  /// this (docs/motion.md, "Acceleration on curves").
+  uint32_t axis_accel[kMaxAxes];
 };
 
 /// Draw a patch as isolines: lines_s s-lines then lines_t t-lines, each a
