@@ -217,6 +217,15 @@ class Session {
                           : in_.ConsumeIntegralInRange<std::uint32_t>(1000, 10'000'000);
     config.pen_delay_ms = Rare() ? in_.ConsumeIntegral<std::uint16_t>()
                                  : in_.ConsumeIntegralInRange<std::uint16_t>(0, 20);
+    config.travel_rate = Rare()
+                             ? in_.ConsumeIntegral<std::uint32_t>()
+                             : in_.ConsumeIntegralInRange<std::uint32_t>(1, fdsurf::fuzz::kTickHz);
+    for (int a = 0; a < protocol::kMaxAxes; ++a) {
+      const bool used = a < config.axes;
+      config.axis_accel[a] = Rare() ? in_.ConsumeIntegral<std::uint32_t>()
+                             : used ? in_.ConsumeIntegralInRange<std::uint32_t>(1000, 10'000'000)
+                                    : 0;
+    }
     pending_config_ = config;
     SendCommand(command);
   }

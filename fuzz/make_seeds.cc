@@ -82,6 +82,9 @@ protocol::Command Config(std::int32_t travel) {
   c.max_rate = 8000;
   c.accel = 160000;
   c.pen_delay_ms = 2;
+  c.travel_rate = 8000;
+  c.axis_accel[0] = c.axis_accel[1] = 160000;
+  c.axis_accel[2] = 0;
   return command;
 }
 

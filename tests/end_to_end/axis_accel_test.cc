@@ -35,6 +35,8 @@ protocol::Command Config() {
   config.body.config.max_rate = kMaxRate;
   config.body.config.accel = kAccel;
   config.body.config.pen_delay_ms = 5;
+  config.body.config.travel_rate = kMaxRate;
+  config.body.config.axis_accel[0] = config.body.config.axis_accel[1] = kAccel;
   return config;
 }
 

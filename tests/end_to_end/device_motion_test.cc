@@ -292,6 +292,8 @@ protocol::MachineConfig Config(std::int32_t travel) {
   config.max_rate = 8000;
   config.accel = 160000;
   config.pen_delay_ms = 10;
+  config.travel_rate = 8000;
+  config.axis_accel[0] = config.axis_accel[1] = 160000;
   return config;
 }
 

@@ -34,6 +34,8 @@ protocol::Command ConfigCommand() {
   config.max_rate = kMaxRate;
   config.accel = kAccel;
   config.pen_delay_ms = kPenDelayMs;
+  config.travel_rate = config.max_rate;
+  config.axis_accel[0] = config.axis_accel[1] = config.accel;
   return command;
 }
 

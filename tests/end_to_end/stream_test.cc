@@ -236,6 +236,8 @@ TEST(SimulatedPlotter, ChargesTheDevicesComputeTime) {
   config.body.config.travel_steps[0] = config.body.config.travel_steps[1] = 100;
   config.body.config.max_rate = 8000;
   config.body.config.accel = 160000;
+  config.body.config.travel_rate = 8000;
+  config.body.config.axis_accel[0] = config.body.config.axis_accel[1] = 160000;
   protocol::Command patch;
   patch.type = protocol::MessageType::kPatch;
   patch.seq = 0;

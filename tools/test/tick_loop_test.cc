@@ -77,6 +77,8 @@ protocol::Command Config() {
   config.max_rate = kMaxRate;
   config.accel = kAccel;
   config.pen_delay_ms = 0;
+  config.travel_rate = kMaxRate;
+  config.axis_accel[0] = config.axis_accel[1] = kAccel;
   return command;
 }
 

@@ -68,6 +68,10 @@ void WriteCommandBody(const Command& command, Writer* w) {
       w->PutU32(c.max_rate);
       w->PutU32(c.accel);
       w->PutU16(c.pen_delay_ms);
+      w->PutU32(c.travel_rate);
+      for (const uint32_t accel : c.axis_accel) {
+        w->PutU32(accel);
+      }
       w->PutU16(c.servo_up_us);
       w->PutU16(c.servo_down_us);
       w->Put(c.flags);
@@ -269,6 +273,14 @@ void ReadConfig(Reader* r, MachineConfig* c) {
   c->accel = r->U32(kConfigFieldAccel);
   r->Check(c->accel >= 1, kConfigFieldAccel);
   c->pen_delay_ms = r->U16(kConfigFieldPenDelay);
+  c->travel_rate = r->U32(kConfigFieldTravelRate);
+  r->Check(c->travel_rate >= 1, kConfigFieldTravelRate);
+  for (int a = 0; a < kMaxAxes; ++a) {
+    const uint8_t field = static_cast<uint8_t>(kConfigFieldAxisAccel + a);
+    c->axis_accel[a] = r->U32(field);
+    // Used axes need a limit; unused ones must be 0.
+    r->Check(a < c->axes ? c->axis_accel[a] >= 1 : c->axis_accel[a] == 0, field);
+  }
   ReadServo(r, c);
   c->flags = r->U8(kConfigFieldFlags);
   r->Check((c->flags & ~kConfigKnownFlags) == 0, kConfigFieldFlags);

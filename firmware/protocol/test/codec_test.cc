@@ -55,7 +55,8 @@ Command Config() {
   Command c;
   c.type = MessageType::kConfig;
   c.seq = 0;
-  c.body.config = MachineConfig{2, {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150, 0, 0};
+  c.body.config = MachineConfig{2,    {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150,
+                                6000, {30000, 25000, 0}, 0,     0,     0};
   return c;
 }
 
@@ -156,15 +157,16 @@ TEST(Codec, CommandRoundTrips) {
   config3.body.config.axes = 3;
   config3.body.config.steps_per_meter[2] = 400000;
   config3.body.config.travel_steps[2] = kMaxTravelSteps;
+  config3.body.config.axis_accel[2] = 0xFFFFFFFFu;
   ExpectRoundTrip(config3);
   Command servo = Config();
   servo.body.config.servo_up_us = 1200;
   servo.body.config.servo_down_us = 1850;
   ExpectRoundTrip(servo);
-  // The widths on the wire, after pen_delay_ms: u16 little-endian each.
+  // The widths on the wire, after axis_accel: u16 little-endian each, then flags.
   const Bytes servo_body = CommandBody(servo);
-  ASSERT_GE(servo_body.size(), 4u);
-  EXPECT_EQ(Bytes(servo_body.end() - 4, servo_body.end()), (Bytes{0xB0, 0x04, 0x3A, 0x07}));
+  ASSERT_EQ(servo_body.size(), 56u);
+  EXPECT_EQ(Bytes(servo_body.end() - 5, servo_body.end() - 1), (Bytes{0xB0, 0x04, 0x3A, 0x07}));
   for (uint64_t salt = 0; salt < 50; ++salt) {
     ExpectRoundTrip(Patch(2, salt));
     ExpectRoundTrip(Patch(3, salt));
@@ -185,7 +187,7 @@ TEST(Codec, CommandRoundTrips) {
 }
 
 // HOME is axes u8, toward_max u8, rate u32, backoff u32 (10 bytes); MOTORS
-// one byte; CONFIG's flags byte follows pen_delay_ms.
+// one byte; CONFIG's flags byte is its last (after the servo widths).
 TEST(Codec, HomeMotorsAndFlagsBodies) {
   EXPECT_EQ(CommandBody(Home(0x03, 0x02, 0x01020304u, 0x0A0B0C0Du)),
             (Bytes{0x03, 0x02, 0x04, 0x03, 0x02, 0x01, 0x0D, 0x0C, 0x0B, 0x0A}));
@@ -194,7 +196,7 @@ TEST(Codec, HomeMotorsAndFlagsBodies) {
   Command config = Config();
   config.body.config.flags = kConfigFlagHomingRequired;
   const Bytes body = CommandBody(config);
-  ASSERT_EQ(body.size(), 36u);
+  ASSERT_EQ(body.size(), 56u);
   EXPECT_EQ(body.back(), kConfigFlagHomingRequired);
 }
 
@@ -275,6 +277,18 @@ TEST(CodecValidation, Config) {
                 bad, 6);  // Z used, travel 0
   ExpectRefused(with([](MachineConfig* m) { m->max_rate = 0; }), bad, kConfigFieldMaxRate);
   ExpectRefused(with([](MachineConfig* m) { m->accel = 0; }), bad, kConfigFieldAccel);
+  ExpectRefused(with([](MachineConfig* m) { m->travel_rate = 0; }), bad, kConfigFieldTravelRate);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[0] = 0; }), bad, kConfigFieldAxisAccel);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[1] = 0; }), bad,
+                kConfigFieldAxisAccel + 1);
+  ExpectRefused(with([](MachineConfig* m) { m->axis_accel[2] = 7; }), bad,
+                kConfigFieldAxisAccel + 2);  // unused
+  ExpectRefused(with([](MachineConfig* m) {
+                  m->axes = 3;
+                  m->steps_per_meter[2] = 1;
+                  m->travel_steps[2] = 10;
+                }),
+                bad, kConfigFieldAxisAccel + 2);  // Z used, no limit
   // The servo pen: both 0 (a switch) or each in 500..2500.
   const auto servo = [&](uint16_t up, uint16_t down) {
     return with([=](MachineConfig* m) {
@@ -404,7 +418,7 @@ TEST(CodecValidation, ExactLength) {
   const Bytes pen = {1, 0};
   EXPECT_EQ(DecodeCommand(BodyFrame(MessageType::kPen, pen), &out).field, kPenFieldCount);
   Bytes config_short = CommandBody(Config());
-  ASSERT_EQ(config_short.size(), 40u);
+  ASSERT_EQ(config_short.size(), 56u);
   config_short.pop_back();  // flags missing
   DecodeResult r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
@@ -413,10 +427,14 @@ TEST(CodecValidation, ExactLength) {
   r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
   EXPECT_EQ(r.field, kConfigFieldServoDown);
-  config_short.resize(35 - 1);  // pen_delay_ms cut short
+  config_short.resize(51 - 1);  // axis_accel[z] cut short
   r = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
   EXPECT_EQ(r.code, ErrorCode::kBadLength);
-  EXPECT_EQ(r.field, kConfigFieldPenDelay);
+  EXPECT_EQ(r.field, kConfigFieldAxisAccel + 2);
+  config_short.resize(35);  // a version 2 config: ends after pen_delay_ms
+  const DecodeResult v2 = DecodeCommand(BodyFrame(MessageType::kConfig, config_short), &out);
+  EXPECT_EQ(v2.code, ErrorCode::kBadLength);
+  EXPECT_EQ(v2.field, kConfigFieldTravelRate);
   const Bytes patch_cut = {2, 2, 2, 0, 0, 0, 1, 0, 0, 0, 0, 5};  // one of 32 geometry values
   const DecodeResult p = DecodeCommand(BodyFrame(MessageType::kPatch, patch_cut), &out);
   EXPECT_EQ(p.code, ErrorCode::kBadLength);

@@ -67,7 +67,10 @@ std::string FieldName(MessageType type, uint8_t index) {
       if (index >= p::kConfigFieldTravel && index < p::kConfigFieldMaxRate) {
         return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
       }
-      const std::array<const char*, 3> rest = {"max_rate", "accel", "pen_delay_ms"};
+      const std::array<const char*, 4> rest = {"max_rate", "accel", "pen_delay_ms", "travel_rate"};
+      if (index >= p::kConfigFieldAxisAccel && index < p::kConfigFieldServoUp) {
+        return "axis_accel[" + axis(index - p::kConfigFieldAxisAccel) + "]";
+      }
       if (index == p::kConfigFieldServoUp) {
         return "servo_up_us";
       }
@@ -77,7 +80,7 @@ std::string FieldName(MessageType type, uint8_t index) {
       if (index == p::kConfigFieldFlags) {
         return "flags";
       }
-      if (index >= p::kConfigFieldMaxRate && index <= p::kConfigFieldPenDelay) {
+      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldAxisAccel) {
         return rest[index - p::kConfigFieldMaxRate];
       }
       break;

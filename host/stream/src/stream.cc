@@ -137,6 +137,11 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   config.max_rate = static_cast<std::uint32_t>(max_rate);
   config.accel = static_cast<std::uint32_t>(accel);
   config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
+  // Protocol 3 fields: no separate travel speed or per-axis limit yet, so
+  // the pen-down speed and the path acceleration (what an axis-aligned move
+  // already demands of an axis).
+  config.travel_rate = config.max_rate;
+  for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = config.accel;
   SetServoPulses(machine, &config);
   return config;
 }

@@ -93,12 +93,21 @@ struct MachineConfig {
   uint32_t steps_per_meter[kMaxAxes];
   /// Each axis moves within [0, travel_steps], 1 ≤ travel_steps < 2^30.
   int32_t travel_steps[kMaxAxes];
-  /// Path speed limit in steps per second, 1 ≤ max_rate ≤ the device's tick rate.
+  /// Path speed limit with the pen down, steps per second,
+  /// 1 ≤ max_rate ≤ the device's tick rate.
   uint32_t max_rate;
   /// Path acceleration limit in steps per second², ≥ 1.
   uint32_t accel;
   /// Rest after every pen change before motion resumes, milliseconds.
   uint16_t pen_delay_ms;
+  /// Path speed limit with the pen up (travel), steps per second,
+  /// 1 ≤ travel_rate ≤ the device's tick rate.
+  uint32_t travel_rate;
+  /// Each axis's acceleration limit, steps per second²: ≥ 1 for used axes,
+  /// 0 for unused ones. `accel` stays the limit along the path; the device
+  /// also keeps every axis's share, the centripetal part included, within
+  /// this (docs/motion.md, "Acceleration on curves").
+  uint32_t axis_accel[kMaxAxes];
   /// A hobby-servo pen lift's pulse widths, µs, every 20 ms: with the pen up
   /// and with it down. Both 0: the pen output is a plain switch; else each
   /// in 500..2500 (hal/pwm.h ServoPen).
