@@ -85,6 +85,9 @@ protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz, bool 
   config.max_rate = static_cast<std::uint32_t>(std::clamp(rate, 1.0, double(tick_hz)));
   config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / s.step)));
   config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
+  // As stream's ConfigFor: no separate travel speed or per-axis limit yet.
+  config.travel_rate = config.max_rate;
+  for (int a = 0; a < s.axes; ++a) config.axis_accel[a] = config.accel;
   config.flags = require_homing ? protocol::kConfigFlagHomingRequired : 0;
   return config;
 }

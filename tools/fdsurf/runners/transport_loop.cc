@@ -316,14 +316,17 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
     throw DeviceError(device + ": the device drives " + std::to_string(hello.max_axes) +
                       " axes; the job needs " + std::to_string(job.config.axes) + " (--dims)");
   }
-  if (job.config.max_rate <= hello.tick_hz) return job;
+  if (job.config.max_rate <= hello.tick_hz && job.config.travel_rate <= hello.tick_hz) return job;
   StreamJob fitted = job;
-  fitted.config.max_rate = hello.tick_hz;
+  const auto fit = [&](protocol::MachineConfig* config) {
+    config->max_rate = std::min(config->max_rate, hello.tick_hz);
+    config->travel_rate = std::min(config->travel_rate, hello.tick_hz);
+  };
+  fit(&fitted.config);
   for (protocol::Command& command : fitted.commands) {
-    if (command.type == protocol::MessageType::kConfig)
-      command.body.config.max_rate = hello.tick_hz;
+    if (command.type == protocol::MessageType::kConfig) fit(&command.body.config);
   }
-  if (!o.quiet) {
+  if (!o.quiet && job.config.max_rate > hello.tick_hz) {
     const double lowered = o.speed * hello.tick_hz / job.config.max_rate;
     std::fprintf(stderr,
                  "fdsurf: note: %s ticks at %u Hz, one step per tick at most: the speed limit is "
