@@ -75,7 +75,53 @@ int __wrap_gpiod_line_request_output(gpiod_line* line, const char* consumer, int
   g_fake_gpio->log.push_back("request " + std::to_string(Line(line)->offset) + " " + consumer +
                              " " + std::to_string(default_val));
   Line(line)->requested = true;
+  Line(line)->request = g_fake_gpio->next_request++;
   Line(line)->value = default_val;
+  return 0;
+}
+
+int __wrap_gpiod_line_request_bulk_output(gpiod_line_bulk* bulk, const char* consumer,
+                                          const int* default_vals) {
+  std::string offsets;
+  std::string values;
+  for (unsigned i = 0; i < bulk->num_lines; ++i) {
+    if (Line(bulk->lines[i])->request_errno != 0) {
+      errno = Line(bulk->lines[i])->request_errno;
+      return -1;  // the kernel grants all lines of one request or none
+    }
+    offsets += (i > 0 ? "," : "") + std::to_string(Line(bulk->lines[i])->offset);
+    values += (i > 0 ? "," : "") + std::to_string(default_vals[i]);
+  }
+  g_fake_gpio->log.push_back("request " + offsets + " " + consumer + " " + values);
+  const int request = g_fake_gpio->next_request++;
+  for (unsigned i = 0; i < bulk->num_lines; ++i) {
+    Line(bulk->lines[i])->requested = true;
+    Line(bulk->lines[i])->request = request;
+    Line(bulk->lines[i])->value = default_vals[i];
+  }
+  return 0;
+}
+
+// Like libgpiod 1.6: one ioctl on the first line's request, so every line
+// must belong to that same request (else EINVAL here; libgpiod refuses too).
+int __wrap_gpiod_line_set_value_bulk(gpiod_line_bulk* bulk, const int* values) {
+  std::string entry = "set ";
+  int fail_errno = 0;
+  for (unsigned i = 0; i < bulk->num_lines; ++i) {
+    const auto* line = Line(bulk->lines[i]);
+    entry += (i > 0 ? "," : "") + std::to_string(line->offset) + "=" + std::to_string(values[i]);
+    if (line->set_errno != 0 && (line->set_fails_for < 0 || line->set_fails_for == values[i])) {
+      fail_errno = line->set_errno;
+    }
+    if (!line->requested || line->request != Line(bulk->lines[0])->request) fail_errno = EINVAL;
+  }
+  g_fake_gpio->log.push_back(entry + (fail_errno != 0 ? " (fails)" : ""));
+  g_fake_gpio->set_times_us.push_back(fdsurf::hal::MonotonicClock::Now());
+  if (fail_errno != 0) {
+    errno = fail_errno;
+    return -1;
+  }
+  for (unsigned i = 0; i < bulk->num_lines; ++i) Line(bulk->lines[i])->value = values[i];
   return 0;
 }
 
@@ -100,6 +146,7 @@ int __wrap_gpiod_line_set_value(gpiod_line* line, int value) {
 void __wrap_gpiod_line_release(gpiod_line* line) {
   g_fake_gpio->log.push_back("release " + std::to_string(Line(line)->offset));
   Line(line)->requested = false;
+  Line(line)->request = 0;
 }
 
 }  // extern "C"

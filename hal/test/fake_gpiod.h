@@ -21,6 +21,9 @@ struct FakeGpioLine {
   int set_errno = 0;       // non-zero: gpiod_line_set_value fails with it
   int set_fails_for = -1;  // with set_errno: only setting this value fails (-1: any)
   bool requested = false;
+  /// Which request holds the line (lines requested together share one,
+  /// as they share one file descriptor in libgpiod); 0 when not requested.
+  int request = 0;
   int value = -1;
 };
 
@@ -34,10 +37,14 @@ struct FakeGpio {
   std::map<std::string, FakeGpioChip> chips;
   /// errno of a lookup of a descriptor not in `chips`.
   int missing_errno = 2;  // ENOENT
-  /// "lookup gpiochip0", "request 17 fdsurf 0", "set 17=1", "release 17", "close".
+  /// "lookup gpiochip0", "request 17 fdsurf 0", "set 17=1", "release 17", "close";
+  /// lines requested or set in one bulk call: "request 17,22 fdsurf 0,0",
+  /// "set 17=1,22=0".
   std::vector<std::string> log;
   /// When each "set" entry happened (CLOCK_MONOTONIC µs), parallel to the sets in `log`.
   std::vector<uint64_t> set_times_us;
+  /// The number the next request gets.
+  int next_request = 1;
 
   /// A chip with `count` unused lines, opened by `descriptor`.
   FakeGpioChip& AddChip(const std::string& descriptor, unsigned count);

@@ -61,9 +61,10 @@ TEST_F(GpiodTest, OpenRequestsEveryLineInactive) {
   std::unique_ptr<GpiodOutputs> outputs;
   ASSERT_EQ(GpiodOutputs::Open(config, &outputs, &error), IoStatus::kOk) << error;
   // STEP low, DIR low (positive), ~EN high (motors off), pen low (up).
-  EXPECT_EQ(fake_.log, (Log{"lookup gpiochip0", "request 17 fdsurf 0", "request 27 fdsurf 0",
-                            "request 22 fdsurf 0", "request 23 fdsurf 0", "request 24 fdsurf 1",
-                            "request 25 fdsurf 0"}));
+  // The STEP lines in one request, so that one call sets them all.
+  EXPECT_EQ(fake_.log,
+            (Log{"lookup gpiochip0", "request 27 fdsurf 0", "request 23 fdsurf 0",
+                 "request 24 fdsurf 1", "request 25 fdsurf 0", "request 17,22 fdsurf 0,0"}));
   EXPECT_EQ(static_cast<StepDirOutputs&>(*outputs).axes(), 2);
   EXPECT_STREQ(outputs->LastError(), "");
 }
@@ -98,15 +99,16 @@ TEST_F(GpiodTest, StepGoesHighThenLowForAtLeastThePulseWidth) {
   auto outputs = OpenSpec("gpio:gpiochip0:17,27,22,23,24,25", config);
   StepDirOutputs& steps = *outputs;
   ASSERT_EQ(steps.Step(0b01), IoStatus::kOk);
-  EXPECT_EQ(fake_.log, (Log{"set 17=1", "set 17=0"}));
+  EXPECT_EQ(fake_.log, (Log{"set 17=1,22=0", "set 17=0,22=0"}));
   ASSERT_EQ(fake_.set_times_us.size(), 2u);
   EXPECT_GE(fake_.set_times_us[1] - fake_.set_times_us[0], 50u);
   EXPECT_EQ(Value(17), 0);
 
   fake_.log.clear();
   ASSERT_EQ(steps.Step(0b11), IoStatus::kOk);
-  EXPECT_EQ(fake_.log, (Log{"set 17=1", "set 22=1", "set 17=0", "set 22=0"}));
-  ASSERT_EQ(fake_.set_times_us.size(), 6u);
+  // A diagonal step: both edges of both axes in one call each.
+  EXPECT_EQ(fake_.log, (Log{"set 17=1,22=1", "set 17=0,22=0"}));
+  ASSERT_EQ(fake_.set_times_us.size(), 4u);
   EXPECT_GE(fake_.set_times_us[2] - fake_.set_times_us[1], 50u);  // low time between pulses
   fake_.log.clear();
   ASSERT_EQ(steps.Step(0), IoStatus::kOk);
@@ -120,7 +122,7 @@ TEST_F(GpiodTest, DirectionIsSetBeforeTheStepAndOnlyWhenItChanges) {
   StepDirOutputs& steps = *outputs;
   ASSERT_EQ(steps.SetDirections(0b10), IoStatus::kOk);
   ASSERT_EQ(steps.Step(0b10), IoStatus::kOk);
-  EXPECT_EQ(fake_.log, (Log{"set 23=1", "set 22=1", "set 22=0"}));
+  EXPECT_EQ(fake_.log, (Log{"set 23=1", "set 17=0,22=1", "set 17=0,22=0"}));
   EXPECT_GE(fake_.set_times_us[1] - fake_.set_times_us[0], 40u);  // DIR set-up time
   EXPECT_EQ(Value(23), 1);
 
@@ -148,9 +150,9 @@ TEST_F(GpiodTest, PolarityPrefixesInvertLines) {
   ASSERT_TRUE(ParseGpioDevice("gpio:gpiochip0:17,!27,22,23,+24,!25", &config, &error)) << error;
   std::unique_ptr<GpiodOutputs> outputs;
   ASSERT_EQ(GpiodOutputs::Open(config, &outputs, &error), IoStatus::kOk) << error;
-  EXPECT_EQ(fake_.log, (Log{"lookup gpiochip0", "request 17 fdsurf 0", "request 27 fdsurf 1",
-                            "request 22 fdsurf 0", "request 23 fdsurf 0", "request 24 fdsurf 0",
-                            "request 25 fdsurf 1"}));
+  EXPECT_EQ(fake_.log,
+            (Log{"lookup gpiochip0", "request 27 fdsurf 1", "request 23 fdsurf 0",
+                 "request 24 fdsurf 0", "request 25 fdsurf 1", "request 17,22 fdsurf 0,0"}));
   fake_.log.clear();
   StepDirOutputs& steps = *outputs;
   PenOutput& pen = *outputs;
@@ -185,7 +187,7 @@ TEST_F(GpiodTest, ThreeAxes) {
   EXPECT_EQ(steps.axes(), 3);
   ASSERT_EQ(steps.SetDirections(0b100), IoStatus::kOk);
   ASSERT_EQ(steps.Step(0b101), IoStatus::kOk);
-  EXPECT_EQ(fake_.log, (Log{"set 6=1", "set 1=1", "set 5=1", "set 1=0", "set 5=0"}));
+  EXPECT_EQ(fake_.log, (Log{"set 6=1", "set 1=1,3=0,5=1", "set 1=0,3=0,5=0"}));
 }
 
 TEST_F(GpiodTest, MasksBeyondTheAxesAreRefused) {
@@ -215,8 +217,9 @@ TEST_F(GpiodTest, FailedSetNamesTheLineAndStillEndsThePulse) {
   StepDirOutputs& steps = *outputs;
   EXPECT_EQ(steps.Step(0b11), IoStatus::kIoError);
   EXPECT_STREQ(steps.LastError(),
-               "gpio gpiochip0: cannot set line 22 (STEPY) to 1: Input/output error");
-  EXPECT_EQ(fake_.log, (Log{"set 17=1", "set 22=1 (fails)", "set 17=0", "set 22=0 (fails)"}));
+               "gpio gpiochip0: cannot set step lines 17 (STEPX), 22 (STEPY) to STEPX=1, STEPY=1: "
+               "Input/output error");
+  EXPECT_EQ(fake_.log, (Log{"set 17=1,22=1 (fails)", "set 17=0,22=0 (fails)"}));
   EXPECT_EQ(Value(17), 0);
 }
 
@@ -232,9 +235,9 @@ TEST_F(GpiodTest, FailedLowEdgeIsReportedAndOldErrorsAreNot) {
   fake_.log.clear();
   EXPECT_EQ(steps.Step(0b11), IoStatus::kIoError);
   EXPECT_STREQ(steps.LastError(),
-               "gpio gpiochip0: cannot set line 17 (STEPX) to 0: Device or resource busy");
-  EXPECT_EQ(fake_.log, (Log{"set 17=1", "set 22=1", "set 17=0 (fails)", "set 22=0"}));
-  EXPECT_EQ(Value(22), 0);
+               "gpio gpiochip0: cannot set step lines 17 (STEPX), 22 (STEPY) to STEPX=0, STEPY=0: "
+               "Device or resource busy");
+  EXPECT_EQ(fake_.log, (Log{"set 17=1,22=1", "set 17=0,22=0 (fails)"}));
 }
 
 TEST_F(GpiodTest, MissingChipListsTheChipsPresent) {
@@ -286,9 +289,8 @@ TEST_F(GpiodTest, OffsetBeyondTheChipReleasesWhatWasRequested) {
   std::string error;
   EXPECT_EQ(OpenFails("gpio:pinctrl-small:17,20,22,23,24,25", &error), IoStatus::kNotFound);
   EXPECT_EQ(error, "gpio pinctrl-small: line 24 (EN) does not exist: the chip has 24 lines (0-23)");
-  EXPECT_EQ(fake_.log, (Log{"lookup pinctrl-small", "request 17 fdsurf 0", "request 20 fdsurf 0",
-                            "request 22 fdsurf 0", "request 23 fdsurf 0", "release 17",
-                            "release 20", "release 22", "release 23", "close"}));
+  EXPECT_EQ(fake_.log, (Log{"lookup pinctrl-small", "request 20 fdsurf 0", "request 23 fdsurf 0",
+                            "release 20", "release 23", "close"}));
 }
 
 TEST_F(GpiodTest, BusyLineNamesItsConsumer) {
@@ -297,15 +299,28 @@ TEST_F(GpiodTest, BusyLineNamesItsConsumer) {
   std::string error;
   EXPECT_EQ(OpenFails("gpio:gpiochip0:17,27,22,23,24,25", &error), IoStatus::kBusy);
   EXPECT_EQ(error, "gpio gpiochip0: line 22 (STEPY) is busy: used by 'spi0 CS0'");
-  EXPECT_EQ(fake_.log, (Log{"lookup gpiochip0", "request 17 fdsurf 0", "request 27 fdsurf 0",
-                            "release 17", "release 27", "close"}));
+  EXPECT_EQ(fake_.log, (Log{"lookup gpiochip0", "request 27 fdsurf 0", "release 27", "close"}));
 }
 
 TEST_F(GpiodTest, BusyOnRequestWithoutConsumerName) {
   chip_->lines[17].request_errno = EBUSY;  // taken between is_used and the request
   std::string error;
   EXPECT_EQ(OpenFails("gpio:gpiochip0:17,27,22,23,24,25", &error), IoStatus::kBusy);
-  EXPECT_EQ(error, "gpio gpiochip0: line 17 (STEPX) is busy: used by another program or driver");
+  EXPECT_EQ(error,
+            "gpio gpiochip0: step lines 17 (STEPX), 22 (STEPY) are busy: used by another program "
+            "or driver");
+  // The other lines were granted and are given back, left safe.
+  EXPECT_EQ(fake_.log.back(), "close");
+  EXPECT_FALSE(chip_->lines[27].requested);
+  chip_->lines[17].request_errno = EACCES;
+  EXPECT_EQ(OpenFails("gpio:gpiochip0:17,27,22,23,24,25", &error), IoStatus::kPermissionDenied);
+  EXPECT_EQ(error,
+            "gpio gpiochip0: permission denied requesting step lines 17 (STEPX), 22 (STEPY)");
+  chip_->lines[17].request_errno = EINVAL;
+  EXPECT_EQ(OpenFails("gpio:gpiochip0:17,27,22,23,24,25", &error), IoStatus::kIoError);
+  EXPECT_EQ(error,
+            "gpio gpiochip0: cannot request step lines 17 (STEPX), 22 (STEPY) as outputs: Invalid "
+            "argument");
 }
 
 TEST_F(GpiodTest, RequestPermissionDeniedAndOtherErrors) {

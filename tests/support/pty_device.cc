@@ -67,16 +67,18 @@ struct Options {
 };
 
 // Counts steps per axis and folds every step and pen change, in order, into
-// an FNV-1a digest: two runs that executed the same commands once each have
+// an FNV-1a digest (the 64-bit offset basis and prime of
+// http://www.isthe.com/chongo/tech/comp/fnv/, as tests/kernel/gadget_device.cc):
+// two runs that executed the same commands once each have
 // the same digest.
 class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf::hal::PenOutput {
  public:
   RecordingOutputs() : StepDirOutputs(2) {}
   uint64_t steps[3] = {0, 0, 0};
   int64_t position[3] = {0, 0, 0};  // signed, for the endstops
-  uint64_t digest = 1469598103934665603ull;
+  uint64_t digest = 14695981039346656037ull;  // FNV-1a 64-bit offset basis
   /// The same over the steps only (a pause adds a pen lift and lowering).
-  uint64_t step_digest = 1469598103934665603ull;
+  uint64_t step_digest = 14695981039346656037ull;
   bool pen_down = false;
   bool enabled = false;
 

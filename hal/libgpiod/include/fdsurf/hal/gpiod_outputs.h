@@ -123,6 +123,13 @@ class GpiodOutputs final : public StepDirOutputs, public PenOutput {
   IoStatus DoSetPen(bool down) override;
   FDSURF_NODISCARD const char* DoLastError() const override { return last_error_.c_str(); }
 
+  static constexpr int kMaxAxes = 3;
+
+  FDSURF_NODISCARD bool IsStepLine(int index) const { return index < 2 * axes() && index % 2 == 0; }
+  IoStatus RequestStepLines(gpiod_line* const* handles, const int* initial, int count,
+                            std::string* error);
+  FDSURF_NODISCARD std::string StepLineList() const;
+  IoStatus SetSteps(uint8_t active_mask);
   IoStatus Set(int index, bool active);
   IoStatus CheckMask(uint8_t mask, const char* what);
 
