@@ -95,7 +95,7 @@ TEST_F(MachineCli, PlotGcodeWithTheRampsProfileIsWhatTheSameFlagsWrite) {
   const RunResult flags =
       Run(plot +
           " --flavor marlin --pen servo --servo-up 90 --servo-down 30 --servo-index 0"
-          " --feed 1500 --travel-rate 3000 --dwell 0.2");
+          " --feed 1500 --travel-rate 3000 --dwell 0.2 --accel 500");
   ASSERT_EQ(profile.exit_code, 0) << profile.err;
   EXPECT_EQ(profile.out, flags.out);
   EXPECT_NE(profile.out.find("M280 P0 S30"), std::string::npos);

@@ -33,7 +33,7 @@ const std::map<std::string, std::set<std::string>> kCovered = {
     // PlotOptionsAgreeInBothUnits (and PlotDefaultsAgreeInBothUnits).
     {"plot",
      {"--fit", "--margin", "--tolerance", "--quantum", "--pen-up", "--pen-down", "--feed",
-      "--plunge-feed", "--travel-rate"}},
+      "--plunge-feed", "--travel-rate", "--accel", "--junction-deviation"}},
     // render draws with plot's DrawingOptions and PlacePage: the plot cases
     // cover these; RenderDefaultsAgreeInBothUnits checks the defaults.
     {"render", {"--fit", "--margin", "--tolerance", "--quantum"}},
@@ -243,11 +243,17 @@ TEST_F(Units, PlotOptionsAgreeInBothUnits) {
     const char* inch;
   };
   const Case cases[] = {
-      {"--pen-up", "2.54", "0.1"},        {"--pen-down", "-1.27", "-0.05"},
-      {"--feed", "1270", "50"},           {"--plunge-feed", "254", "10"},
-      {"--travel-rate", "254", "10"},     {"--margin", "25.4", "1"},
-      {"--fit", "254x203.2", "10x8"},     {"--tolerance", "0.0254", "0.001"},
+      {"--pen-up", "2.54", "0.1"},
+      {"--pen-down", "-1.27", "-0.05"},
+      {"--feed", "1270", "50"},
+      {"--plunge-feed", "254", "10"},
+      {"--travel-rate", "254", "10"},
+      {"--margin", "25.4", "1"},
+      {"--fit", "254x203.2", "10x8"},
+      {"--tolerance", "0.0254", "0.001"},
       {"--quantum", "0.00254", "0.0001"},
+      {"--accel", "254", "10"},
+      {"--junction-deviation", "0.0254", "0.001"},
   };
   for (const Case& c : cases) {
     const Program mm = Plot("mm", std::string(c.option) + " " + c.mm);

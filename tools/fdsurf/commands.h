@@ -60,6 +60,11 @@ struct PlotOptions {
   std::optional<double> feed;
   std::optional<double> plunge_feed;
   std::optional<double> travel_rate;
+  /// The time estimate's machine (--accel, --units/s²; --junction-deviation,
+  /// --units), as typed; nullopt: stream's 2000 mm/s² and Grbl's 0.01 mm
+  /// converted to --units.
+  std::optional<double> accel;
+  std::optional<double> junction_deviation;
 };
 
 struct PortsOptions {

@@ -9,12 +9,15 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "fdsurf/host/gcode_estimate.h"
 #include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_io.h"
 #include "fdsurf/host/plan.h"
+#include "fdsurf/host/stream.h"
 #include "fdsurf/host/text.h"
 #include "fdsurf/host/toolpath.h"
 #include "fdsurf/host/writers.h"
+#include "runners/machine_schedule.h"
 
 namespace fdsurf::host {
 namespace {
@@ -126,6 +129,9 @@ ToolpathOptions DrawingOptions(const PlotOptions& o, const std::string& format,
   return t;
 }
 
+// Grbl's default junction deviation, mm (its $11 setting).
+constexpr double kGrblJunctionDeviationMm = 0.01;
+
 // The G-code options with the heights and rates as typed, or GcodeOptions'
 // defaults (mm, mm/min) in --units: a G-code job works in --units.
 GcodeOptions GcodeFor(const PlotOptions& o) {
@@ -139,6 +145,11 @@ GcodeOptions GcodeFor(const PlotOptions& o) {
   g.feed = typed_or_default(o.feed, mm.feed);
   g.plunge_feed = typed_or_default(o.plunge_feed, mm.plunge_feed);
   g.travel_rate = typed_or_default(o.travel_rate, mm.travel_rate);
+  // The estimate's machine: stream's path acceleration, Grbl's default
+  // junction deviation ($11 = 0.010 mm).
+  g.accel = typed_or_default(o.accel, MachineOptions{}.accel);
+  g.junction_deviation = typed_or_default(o.junction_deviation, kGrblJunctionDeviationMm);
+  g.estimate_in_header = true;
   return g;
 }
 
@@ -198,6 +209,31 @@ void PrintSummary(const PlotOptions& o, const PatchSet& set, const ToolpathOptio
   if (!png.empty()) std::fprintf(stderr, "wrote %s (png, %d px wide)\n", png.c_str(), o.png_width);
 }
 
+// The G-code machine estimate on stderr, as `stream --dry-run` prints its
+// own: machine time, distances, lifts, extent, the machine assumed.
+void PrintGcodeEstimate(const Toolpath& path, const GcodeOptions& g) {
+  const GcodeEstimate e = EstimateGcode(path, g);
+  const char* units = path.units.c_str();
+  std::fprintf(stderr, "machine time: %.1f s (%s) on a G-code machine at these feeds\n", e.seconds,
+               FormatClock(e.seconds).c_str());
+  std::fprintf(stderr, "pen down: %.1f %s, travel (G0): %.1f %s, %zu pen lift%s\n",
+               e.pen_down_length, units, e.travel_length, units, e.pen_lifts,
+               e.pen_lifts == 1 ? "" : "s");
+  if (e.drew) {
+    std::string extent = "page extent drawn: x " + FormatNumber(e.lo[0]) + ".." +
+                         FormatNumber(e.hi[0]) + ", y " + FormatNumber(e.lo[1]) + ".." +
+                         FormatNumber(e.hi[1]);
+    if (e.dims == 3) extent += ", z " + FormatNumber(e.lo[2]) + ".." + FormatNumber(e.hi[2]);
+    std::fprintf(stderr, "%s %s\n", extent.c_str(), units);
+  }
+  std::fprintf(stderr,
+               "estimate: feed %s, plunge %s, G0 %s %s/min; accel %s %s/s², junction deviation "
+               "%s %s (docs/toolpaths.md, \"Time estimate\")\n",
+               FormatNumber(g.feed).c_str(), FormatNumber(g.plunge_feed).c_str(),
+               FormatNumber(g.travel_rate).c_str(), units, FormatNumber(g.accel).c_str(), units,
+               FormatNumber(g.junction_deviation).c_str(), units);
+}
+
 // --flavor and the options that only some flavours use (docs/toolpaths.md).
 void AddGcodeFlavorOptions(CLI::App* command, PlotOptions* o) {
   GcodeOptions* g = &o->gcode;
@@ -221,6 +257,16 @@ void AddGcodeFlavorOptions(CLI::App* command, PlotOptions* o) {
                    "G0 rate assumed by the time estimate, --units per minute " +
                        DefaultInMmHelp(GcodeOptions{}.travel_rate, "mm/min"))
       ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--accel", o->accel,
+                   "acceleration of every move in the time estimate, --units per second² " +
+                       DefaultInMmHelp(MachineOptions{}.accel, "mm/s²"))
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--junction-deviation", o->junction_deviation,
+                   "Grbl's junction deviation in the time estimate, in --units " +
+                       DefaultInMmHelp(kGrblJunctionDeviationMm, "mm"))
+      ->check(CLI::NonNegativeNumber);
 }
 
 // --pen-up, --pen-down, --feed and --plunge-feed: in --units, the defaults
@@ -285,10 +331,10 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   // Every output complete before any is renamed into place.
   StagedOutputs outputs;
   std::string content;
+  const GcodeOptions gcode = GcodeFor(o);
   if (format == "svg") content = WriteSvg(path, o.file + " drawn by fdsurf");
   if (format == "gcode") {
-    content =
-        WriteGcode(path, GcodeFor(o), GcodeHeader(o, set, t, path, work_units, counts.points));
+    content = WriteGcode(path, gcode, GcodeHeader(o, set, t, path, work_units, counts.points));
   }
   if (format == "hpgl") content = WriteHpgl(path);
   if (format == "json") content = WriteStrokesJson(path);
@@ -308,6 +354,7 @@ int RunPlot(const PlotOptions& options, bool render_only) {
   if (!o.quiet) {
     PrintSummary(o, set, t, path, work_units, counts, plan, format, !render_only && !to_stdout,
                  png);
+    if (format == "gcode") PrintGcodeEstimate(path, gcode);
   }
   return 0;
 }

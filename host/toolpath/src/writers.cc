@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/host/writers.h"
+#include "fdsurf/host/gcode_estimate.h"
 #include "fdsurf/host/text.h"
 
 #include <cairo.h>
@@ -70,10 +71,6 @@ Flavor FlavorNamed(const std::string& name) {
 
 using QuantaPoint = std::array<std::int64_t, 2>;
 
-double PlaneLength(const QuantaPoint& a, const QuantaPoint& b) {
-  return std::hypot(static_cast<double>(a[0] - b[0]), static_cast<double>(a[1] - b[1]));
-}
-
 // Writes one program; every choice a flavour makes is in Flavor.
 class GcodeWriter {
  public:
@@ -100,9 +97,12 @@ class GcodeWriter {
     if (flavor_.name != "generic") {
       Comment("flavor " + flavor_.name + (use_g5_ ? ", cubics as G5" : ", cubics as G1 segments") +
               ", dwell G4 P in " + (flavor_.dwell_ms ? "milliseconds" : "seconds"));
-      Comment("estimated time " + FormatDuration(EstimateSeconds()) +
-              " (pen-down length / feed + travel / " + FormatNumber(options_.travel_rate) + " " +
-              path_.units + "/min + plunges + dwells)");
+    }
+    if (flavor_.name != "generic" || options_.estimate_in_header) {
+      const GcodeEstimate estimate = EstimateGcode(path_, options_);
+      for (const std::string& line : DescribeGcodeEstimate(estimate, options_, path_.units)) {
+        Comment(line);
+      }
     }
     out_ << (path_.units == "in" ? "G20" : "G21") << Trailing("units: " + path_.units) << "\n"
          << "G90" << Trailing("absolute positions") << "\n";
@@ -130,48 +130,7 @@ class GcodeWriter {
     return out_.str();
   }
 
-  // The model of docs/toolpaths.md, "Time estimate".
-  double EstimateSeconds() const {
-    const double unit = q_.value();
-    double down = 0;    // quanta, at feed
-    double travel = 0;  // quanta in the plane, at travel_rate
-    QuantaPoint pen{0, 0};
-    double plunge = 0;  // units, at plunge_feed
-    double lift = 0;    // units, at travel_rate
-    for (const Stroke& s : path_.strokes) {
-      travel += PlaneLength(pen, {s.points.front()[0], s.points.front()[1]});
-      for (std::size_t k = 1; k < s.points.size(); ++k) {
-        const auto& a = s.points[k - 1];
-        const auto& b = s.points[k];
-        const double dz = three_d_ ? static_cast<double>(b[2] - a[2]) : 0.0;
-        down += std::hypot(PlaneLength({a[0], a[1]}, {b[0], b[1]}), dz);
-      }
-      pen = {s.points.back()[0], s.points.back()[1]};
-      if (three_d_) {
-        plunge += std::fabs(options_.pen_up_z - s.points.front()[2] * unit);
-        lift += std::fabs(options_.pen_up_z - s.points.back()[2] * unit);
-      } else if (pen_ == "z") {
-        plunge += std::fabs(options_.pen_up_z - options_.pen_down_z);
-        lift += std::fabs(options_.pen_up_z - options_.pen_down_z);
-      }
-    }
-    travel += PlaneLength(pen, {0, 0});
-    const bool dwells = pen_ != "z";
-    const double dwell_count = dwells ? 1.0 + 2.0 * path_.strokes.size() : 0.0;
-    return 60 * (down * unit / options_.feed + (travel * unit + lift) / options_.travel_rate +
-                 plunge / options_.plunge_feed) +
-           dwell_count * options_.dwell;
-  }
-
  private:
-  static std::string FormatDuration(double seconds) {
-    const auto whole = static_cast<long long>(std::llround(seconds));
-    char text[48];
-    std::snprintf(text, sizeof text, "%lld:%02lld:%02lld", whole / 3600, whole / 60 % 60,
-                  whole % 60);
-    return text;
-  }
-
   // A comment line in the flavour's syntax.
   void Comment(const std::string& text) {
     if (flavor_.paren_comments) {
@@ -368,7 +327,8 @@ std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
 }
 
 double EstimateGcodeSeconds(const Toolpath& path, const GcodeOptions& options) {
-  return GcodeWriter(path, options).EstimateSeconds();
+  (void)GcodeWriter(path, options);  // the writer's checks
+  return EstimateGcode(path, options).seconds;
 }
 
 std::string WriteHpgl(const Toolpath& path) {

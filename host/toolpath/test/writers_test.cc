@@ -351,8 +351,11 @@ TEST(WriteGcode, MarlinWritesG5MillisecondDwellsServoPenAndPausesBetweenLayers) 
   const std::string expected =
       "; marlin\n"
       "; flavor marlin, cubics as G5, dwell G4 P in milliseconds\n"
-      "; estimated time 0:00:02 (pen-down length / feed + travel / 1200 mm/min + plunges + "
-      "dwells)\n"
+      "; estimated time 0:00:02 = 2.04 s of machine time, docs/toolpaths.md\n"
+      "; estimate: pen down 5.1 mm, travel 5.5 mm, 2 pen lifts\n"
+      "; estimate: extent x 1..4, y 1..2.8 mm\n"
+      "; estimate assumes: feed 600, plunge 300, G0 1200 mm/min\n"
+      "; estimate assumes: accel none, junction deviation 0.01 mm, dwell 0.25 s\n"
       "G21 ; units: mm\n"
       "G90 ; absolute positions\n"
       "M280 P1 S70\n"
@@ -385,8 +388,11 @@ TEST(WriteGcode, LinuxCncSelectsG17AndUsesParenthesisComments) {
   const std::string expected =
       "(source: a [b])\n"
       "(flavor linuxcnc, cubics as G5, dwell G4 P in seconds)\n"
-      "(estimated time 0:00:03 [pen-down length / feed + travel / 3000 mm/min + plunges + "
-      "dwells])\n"
+      "(estimated time 0:00:03 = 3.12 s of machine time, docs/toolpaths.md)\n"
+      "(estimate: pen down 5.1 mm, travel 5.5 mm, 2 pen lifts)\n"
+      "(estimate: extent x 1..4, y 1..2.8 mm)\n"
+      "(estimate assumes: feed 600, plunge 300, G0 3000 mm/min)\n"
+      "(estimate assumes: accel none, junction deviation 0.01 mm, dwell 0.5 s)\n"
       "G21 (units: mm)\n"
       "G90 (absolute positions)\n"
       "G17 (XY plane, for G5)\n"
@@ -418,8 +424,11 @@ TEST(WriteGcode, GrblDrawsTheCubicAsItsSegmentsWithSecondDwells) {
   const GcodeOptions options{.flavor = "grbl", .feed = 600};
   const std::string expected =
       "(flavor grbl, cubics as G1 segments, dwell G4 P in seconds)\n"
-      "(estimated time 0:00:03 [pen-down length / feed + travel / 3000 mm/min + plunges + "
-      "dwells])\n"
+      "(estimated time 0:00:03 = 2.82 s of machine time, docs/toolpaths.md)\n"
+      "(estimate: pen down 5.1 mm, travel 5.5 mm, 2 pen lifts)\n"
+      "(estimate: extent x 1..4, y 1..2.8 mm)\n"
+      "(estimate assumes: feed 600, plunge 300, G0 3000 mm/min)\n"
+      "(estimate assumes: accel none, junction deviation 0.01 mm, dwell 0.2 s)\n"
       "G21 (units: mm)\n"
       "G90 (absolute positions)\n"
       "G0 Z5\n"
@@ -467,6 +476,9 @@ TEST(WriteGcode, GenericIgnoresCubicsAndNamesLayersWithSemicolons) {
   const std::string out = WriteGcode(CubicPath(), GcodeOptions{}, {});
   EXPECT_EQ(out.find("G5"), std::string::npos);
   EXPECT_EQ(out.find("estimated"), std::string::npos);  // generic: no new header lines
+  // Asked for, generic states the estimate too (fdsurf plot asks).
+  const std::string with = WriteGcode(CubicPath(), GcodeOptions{.estimate_in_header = true}, {});
+  EXPECT_EQ(with.rfind("; estimated time 0:00:03 = ", 0), 0u) << with;
   EXPECT_NE(out.find("G0 Z5\n; pen change: layer 'red'\nM0\nG0 X3.00 Y1.00\n"), std::string::npos);
 }
 

@@ -72,7 +72,8 @@ struct Targets {
                                                       {"--pen-down", gcode.pen_down_z},
                                                       {"--feed", gcode.feed},
                                                       {"--plunge-feed", gcode.plunge_feed},
-                                                      {"--travel-rate", gcode.travel_rate}};
+                                                      {"--travel-rate", gcode.travel_rate},
+                                                      {"--junction-deviation", 0.01}};
     for (const auto& [name, mm] : lengths) {
       if (flag == name) return FormatNumber(DefaultIn(mm, units));
     }

@@ -58,6 +58,15 @@ struct GcodeOptions {
   /// The rate assumed for G0 travel in the time estimate (the machine's own
   /// rapid rate is not known here), output units per minute.
   double travel_rate = 3000;
+  /// The time estimate's machine (gcode_estimate.h): the acceleration of
+  /// every move, output units/s² (0: acceleration ignored, each move takes
+  /// length / rate), and Grbl's junction deviation, output units.
+  double accel = 0;
+  double junction_deviation = 0.01;
+  /// Write the estimate's comments in the header for the generic flavour
+  /// too (every other flavour always has them; generic, left alone, stays
+  /// what fdsurf always wrote). fdsurf plot sets it.
+  bool estimate_in_header = false;
   /// Dwell after M3/M5 and after each servo move, seconds.
   double dwell = 0.2;
   /// M3 spindle/laser power word.
@@ -71,7 +80,8 @@ struct GcodeOptions {
 /// cubics, see GcodeOptions::g5). In 3-D the Z of each point is the
 /// surface's depth and travel happens at pen_up_z. `header` lines become
 /// leading comments; every flavour but generic adds its name and the
-/// estimated machine time. Between layers: the pen lifted, a comment naming
+/// estimate (DescribeGcodeEstimate, gcode_estimate.h) as comments, generic
+/// the estimate when options.estimate_in_header. Between layers: the pen lifted, a comment naming
 /// the next layer and M0. Throws OptionError ("pen") for a flavour or pen
 /// that is not known, or servo with a flavour without M280, and
 /// OptionError ("tolerance") when a G5's control points, printed at the
@@ -79,8 +89,9 @@ struct GcodeOptions {
 std::string WriteGcode(const Toolpath& path, const GcodeOptions& options,
                        const std::vector<std::string>& header);
 
-/// The estimated machine time of WriteGcode's program, seconds: pen-down
-/// length / feed + travel (G0, pen lifts) / travel_rate + plunges /
+/// The estimated machine time of WriteGcode's program, seconds:
+/// EstimateGcode(path, options).seconds (gcode_estimate.h). With accel 0:
+/// pen-down length / feed + travel (G0, pen lifts) / travel_rate + plunges /
 /// plunge_feed + dwells (docs/toolpaths.md, "Time estimate").
 double EstimateGcodeSeconds(const Toolpath& path, const GcodeOptions& options);
 
