@@ -181,6 +181,35 @@ GpiodOutputs::GpiodOutputs(const GpiodConfig& config, gpiod_chip* chip)
   }
 }
 
+namespace {
+
+// Opens the chip named in `config`, or says why not (missing, permission,
+// not a GPIO chip, other).
+IoStatus OpenChip(const GpiodConfig& config, gpiod_chip** chip, std::string* error) {
+  errno = 0;
+  *chip = gpiod_chip_open_lookup(config.chip.c_str());
+  if (*chip != nullptr) return IoStatus::kOk;
+  const int e = errno;
+  if (e == ENOENT) {
+    *error = "gpio: no GPIO chip '" + config.chip + "' (" + ListChips(config.dev_dir) + ")";
+    return IoStatus::kNotFound;
+  }
+  if (e == EACCES || e == EPERM) {
+    *error = "gpio: permission denied opening GPIO chip '" + config.chip +
+             "' (add your user to the group owning /dev/gpiochip*, e.g. gpio, or add a udev "
+             "rule; see hal/README.md)";
+    return IoStatus::kPermissionDenied;
+  }
+  if (e == ENOTTY || e == EINVAL || e == ENODEV) {
+    *error = "gpio: '" + config.chip + "' is not a GPIO chip (" + ErrnoText(e) + ")";
+    return IoStatus::kInvalidArgument;
+  }
+  *error = "gpio: cannot open GPIO chip '" + config.chip + "': " + ErrnoText(e);
+  return IoStatus::kIoError;
+}
+
+}  // namespace
+
 IoStatus GpiodOutputs::Open(const GpiodConfig& config, std::unique_ptr<GpiodOutputs>* outputs,
                             std::string* error) {
   outputs->reset();
@@ -189,26 +218,9 @@ IoStatus GpiodOutputs::Open(const GpiodConfig& config, std::unique_ptr<GpiodOutp
     *error = where + std::to_string(config.axes) + " axes (2 or 3 supported)";
     return IoStatus::kInvalidArgument;
   }
-  errno = 0;
-  gpiod_chip* chip = gpiod_chip_open_lookup(config.chip.c_str());
-  if (chip == nullptr) {
-    const int e = errno;
-    if (e == ENOENT) {
-      *error = "gpio: no GPIO chip '" + config.chip + "' (" + ListChips(config.dev_dir) + ")";
-      return IoStatus::kNotFound;
-    }
-    if (e == EACCES || e == EPERM) {
-      *error = "gpio: permission denied opening GPIO chip '" + config.chip +
-               "' (add your user to the group owning /dev/gpiochip*, e.g. gpio, or add a udev "
-               "rule; see hal/README.md)";
-      return IoStatus::kPermissionDenied;
-    }
-    if (e == ENOTTY || e == EINVAL || e == ENODEV) {
-      *error = "gpio: '" + config.chip + "' is not a GPIO chip (" + ErrnoText(e) + ")";
-      return IoStatus::kInvalidArgument;
-    }
-    *error = "gpio: cannot open GPIO chip '" + config.chip + "': " + ErrnoText(e);
-    return IoStatus::kIoError;
+  gpiod_chip* chip = nullptr;
+  if (const IoStatus opened = OpenChip(config, &chip, error); opened != IoStatus::kOk) {
+    return opened;
   }
   std::unique_ptr<GpiodOutputs> self(new GpiodOutputs(config, chip));
   gpiod_line* step_lines[kMaxAxes] = {};
