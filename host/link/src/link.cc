@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <utility>
@@ -52,39 +53,39 @@ const char* TypeName(MessageType type) {
 
 const char* const kAxisNames[] = {"x", "y", "z"};
 
+// CONFIG's fields by index (docs/protocol.md, CONFIG).
+const char* const kConfigFieldNames[] = {"axes",
+                                         "steps_per_meter[x]",
+                                         "steps_per_meter[y]",
+                                         "steps_per_meter[z]",
+                                         "travel_steps[x]",
+                                         "travel_steps[y]",
+                                         "travel_steps[z]",
+                                         "max_rate",
+                                         "accel",
+                                         "pen_delay_ms",
+                                         "travel_rate",
+                                         "axis_accel[x]",
+                                         "axis_accel[y]",
+                                         "axis_accel[z]",
+                                         "servo_up_us",
+                                         "servo_down_us",
+                                         "flags"};
+static_assert(std::size(kConfigFieldNames) == protocol::kConfigFieldCount &&
+                  protocol::kConfigFieldTravelRate == 10 && protocol::kConfigFieldAxisAccel == 11 &&
+                  protocol::kConfigFieldServoUp == 14 && protocol::kConfigFieldFlags == 16,
+              "a name for every CONFIG field, in wire order");
+
 // The name of field `index` of a command body (docs/protocol.md numbers them).
 std::string FieldName(MessageType type, uint8_t index) {
   namespace p = protocol;
   auto axis = [](int a) { return std::string(a < 3 ? kAxisNames[a] : "?"); };
   switch (type) {
-    case MessageType::kConfig: {
-      if (index == p::kConfigFieldAxes) {
-        return "axes";
-      }
-      if (index >= p::kConfigFieldStepsPerMeter && index < p::kConfigFieldTravel) {
-        return "steps_per_meter[" + axis(index - p::kConfigFieldStepsPerMeter) + "]";
-      }
-      if (index >= p::kConfigFieldTravel && index < p::kConfigFieldMaxRate) {
-        return "travel_steps[" + axis(index - p::kConfigFieldTravel) + "]";
-      }
-      const std::array<const char*, 4> rest = {"max_rate", "accel", "pen_delay_ms", "travel_rate"};
-      if (index >= p::kConfigFieldAxisAccel && index < p::kConfigFieldServoUp) {
-        return "axis_accel[" + axis(index - p::kConfigFieldAxisAccel) + "]";
-      }
-      if (index == p::kConfigFieldServoUp) {
-        return "servo_up_us";
-      }
-      if (index == p::kConfigFieldServoDown) {
-        return "servo_down_us";
-      }
-      if (index == p::kConfigFieldFlags) {
-        return "flags";
-      }
-      if (index >= p::kConfigFieldMaxRate && index < p::kConfigFieldAxisAccel) {
-        return rest[index - p::kConfigFieldMaxRate];
+    case MessageType::kConfig:
+      if (index < p::kConfigFieldCount) {
+        return kConfigFieldNames[index];
       }
       break;
-    }
     case MessageType::kPatch: {
       const std::array<const char*, 6> head = {"basis",   "dims",         "lines_s",
                                                "lines_t", "tolerance_q8", "skip_lines"};

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/host/errors.h"
 #include "fdsurf/host/text.h"
 
@@ -56,7 +57,7 @@ class MotionPlan {
  private:
   // The time of the run: Grbl's planner in one go. Speeds are kept squared:
   // v² grows by 2·a·L along a move at acceleration a.
-  double RunSeconds() const {
+  FDSURF_NODISCARD double RunSeconds() const {
     if (accel_ <= 0) {
       double t = 0;
       for (const Block& b : run_) t += b.length / b.rate;
@@ -132,7 +133,7 @@ class ProgramWalk {
   }
 
  private:
-  Vector Point(const std::array<std::int64_t, 3>& p) const {
+  FDSURF_NODISCARD Vector Point(const std::array<std::int64_t, 3>& p) const {
     const double q = path_.quantum.value();
     return {static_cast<double>(p[0]) * q, static_cast<double>(p[1]) * q,
             three_d_ ? static_cast<double>(p[2]) * q : options_.pen_down_z};
@@ -245,7 +246,7 @@ std::vector<std::string> DescribeGcodeEstimate(const GcodeEstimate& e, const Gco
     }
     lines.push_back(extent + " " + units);
   } else {
-    lines.push_back("estimate: extent: nothing drawn");
+    lines.emplace_back("estimate: extent: nothing drawn");
   }
   lines.push_back("estimate assumes: feed " + FormatNumber(o.feed) + ", plunge " +
                   FormatNumber(o.plunge_feed) + ", G0 " + FormatNumber(o.travel_rate) + " " +
