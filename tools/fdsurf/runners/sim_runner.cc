@@ -153,6 +153,7 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   sim::MotionLimitsSi limits;
   limits.tick_hz = tick_hz;
   limits.max_rate = job.config.max_rate;
+  limits.travel_rate = job.config.travel_rate;
   limits.accel = job.config.accel;
   limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
   checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
