@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <unordered_map>
 
+#include "fdsurf/config/nodiscard.h"
+
 namespace fdsurf::sim {
 namespace {
 
@@ -161,7 +163,7 @@ struct MotionCheck {
   std::vector<std::size_t> run;
   std::vector<bool> pen_down;
 
-  double RateFor(bool down) const {
+  FDSURF_NODISCARD double RateFor(bool down) const {
     return down || limits.travel_rate <= 0 ? limits.max_rate : limits.travel_rate;
   }
 

@@ -295,6 +295,7 @@ int RunStream(const StreamOptions& options) {
   ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
   o.speed = machine.speed;  // for the runners' summaries
+  o.travel_speed = machine.travel_speed;
   o.accel = machine.accel;
   const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
