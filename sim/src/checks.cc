@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <unordered_map>
 
+#include "fdsurf/config/nodiscard.h"
+
 namespace fdsurf::sim {
 namespace {
 
@@ -156,23 +158,37 @@ struct MotionCheck {
   std::vector<double> time;
   std::vector<double> distance;
   std::vector<std::array<std::int32_t, 3>> position;
+  /// Per move: the pen events before it (its run between rests) and
+  /// whether the pen was down.
+  std::vector<std::size_t> run;
+  std::vector<bool> pen_down;
+
+  FDSURF_NODISCARD double RateFor(bool down) const {
+    return down || limits.travel_rate <= 0 ? limits.max_rate : limits.travel_rate;
+  }
 
   void Violation(const std::string& what) {
     if (report.violations++ == 0) report.first_violation = what;
   }
 };
 
-// Records the moves, checking each axis's interval between steps.
-void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
+// Records the moves, checking each axis's interval between steps (against
+// the speed limit of the pen's state at the later step).
+void TraceMoves(const std::vector<hal::StepDirEvent>& steps, const std::vector<hal::PenEvent>& pens,
+                MotionCheck& c) {
   MotionReport& report = c.report;
   double total = 0;
   std::array<double, 3> last_step{-1, -1, -1};
   std::array<std::int32_t, 3> position{};
   report.min_axis_interval_us = HUGE_VAL;
-  const double min_interval_s =
-      std::floor(static_cast<double>(c.limits.tick_hz) / c.limits.max_rate) * c.tick_s;
+  const auto min_interval_s = [&c](bool down) {
+    return std::floor(static_cast<double>(c.limits.tick_hz) / c.RateFor(down)) * c.tick_s;
+  };
+  std::size_t pens_before = 0;
   for (const hal::StepDirEvent& e : steps) {
     if (e.axis_mask == 0) continue;
+    while (pens_before < pens.size() && pens[pens_before].time_us <= e.time_us) ++pens_before;
+    const bool down = pens_before > 0 && pens[pens_before - 1].down;
     const double t = e.time_us * 1e-6;
     int axes = 0;
     for (int axis = 0; axis < 3; ++axis) {
@@ -181,10 +197,10 @@ void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
       if (last_step[axis] >= 0) {
         const double interval = t - last_step[axis];
         report.min_axis_interval_us = std::min(report.min_axis_interval_us, interval * 1e6);
-        if (interval < min_interval_s - 1e-9) {
+        if (interval < min_interval_s(down) - 1e-9) {
           c.Violation(
               Describe("axis %.0f stepped %.1f µs after its previous step (at least %.1f µs)", axis,
-                       interval * 1e6, min_interval_s * 1e6));
+                       interval * 1e6, min_interval_s(down) * 1e6));
         }
       }
       last_step[axis] = t;
@@ -194,6 +210,8 @@ void TraceMoves(const std::vector<hal::StepDirEvent>& steps, MotionCheck& c) {
     c.time.push_back(t);
     c.distance.push_back(total);
     c.position.push_back(position);
+    c.run.push_back(pens_before);
+    c.pen_down.push_back(down);
   }
   report.moves = c.time.size();
   report.path_length = total;
@@ -255,7 +273,10 @@ void CheckRests(const std::vector<hal::PenEvent>& pens, MotionCheck& c) {
 }
 
 // Speed over windows of at least window_s: x_j − x_i ≤ v·(t_j − t_i) + 1
-// (the phase carried into and out of the window is below one step).
+// (the phase carried into and out of the window is below one step). v is
+// the limit of the pen's state (max_rate down, travel_rate up) for a window
+// within one run between pen changes, the larger of the two for a window
+// over a pen change (the machine rests there, so that is generous).
 void CheckWindowSpeed(double window_s, MotionCheck& c) {
   std::size_t i = 0;
   for (std::size_t j = 0; j < c.time.size(); ++j) {
@@ -263,10 +284,18 @@ void CheckWindowSpeed(double window_s, MotionCheck& c) {
     const double span = c.time[j] - c.time[i];
     if (span < window_s) continue;
     const double covered = c.distance[j] - c.distance[i];
-    c.report.max_speed = std::max(c.report.max_speed, covered / span);
-    if (covered > c.limits.max_rate * span + 1.0 + 1e-9) {
-      c.Violation(Describe("%.1f steps in %.6f s: faster than %.0f steps/s", covered, span,
-                           c.limits.max_rate));
+    const double speed = covered / span;
+    c.report.max_speed = std::max(c.report.max_speed, speed);
+    const bool one_run = c.run[i] == c.run[j];
+    if (one_run) {
+      double& largest = c.pen_down[j] ? c.report.max_draw_speed : c.report.max_travel_speed;
+      largest = std::max(largest, speed);
+    }
+    const double limit =
+        one_run ? c.RateFor(c.pen_down[j]) : std::max(c.RateFor(true), c.RateFor(false));
+    if (covered > limit * span + 1.0 + 1e-9) {
+      c.Violation(Describe("%.1f steps in %.6f s: faster than %.0f steps/s", covered, span, limit) +
+                  (c.pen_down[j] ? " (pen down)" : " (pen up)"));
     }
   }
 }
@@ -336,8 +365,8 @@ void CheckWindowAxisAccel(double window_s, MotionCheck& c) {
 MotionReport CheckMotion(const std::vector<hal::StepDirEvent>& steps,
                          const std::vector<hal::PenEvent>& pens, const MotionLimitsSi& limits,
                          double window_s) {
-  MotionCheck check{limits, 1.0 / limits.tick_hz, limits.accel, {}, {}, {}, {}};
-  TraceMoves(steps, check);
+  MotionCheck check{limits, 1.0 / limits.tick_hz, limits.accel, {}, {}, {}, {}, {}, {}};
+  TraceMoves(steps, pens, check);
   if (check.time.empty()) return check.report;
   CheckPenDelays(pens, check);
   CheckRests(pens, check);

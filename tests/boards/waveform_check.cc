@@ -146,6 +146,7 @@ MotionLimitsSi LimitsFrom(const WaveformHeader& ref, const std::string& name) {
   MotionLimitsSi limits;
   limits.tick_hz = static_cast<std::uint32_t>(ref.Number("tick_hz", 0));
   limits.max_rate = ref.Number("max_rate", 0);
+  limits.travel_rate = ref.Number("travel_rate", 0);  // absent: max_rate, pen up too
   limits.accel = ref.Number("accel", 0);
   limits.pen_delay_s = ref.Number("pen_delay_ms", 0) * 1e-3;
   if (limits.tick_hz == 0 || !(limits.max_rate > 0) || !(limits.accel > 0)) {

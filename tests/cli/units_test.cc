@@ -38,7 +38,9 @@ const std::map<std::string, std::set<std::string>> kCovered = {
     // cover these; RenderDefaultsAgreeInBothUnits checks the defaults.
     {"render", {"--fit", "--margin", "--tolerance", "--quantum"}},
     // StreamOptionsAgreeInBothUnits (and StreamDefaultsInInchesWork).
-    {"stream", {"--fit", "--margin", "--tolerance", "--step", "--travel", "--speed", "--accel"}},
+    {"stream",
+     {"--fit", "--margin", "--tolerance", "--step", "--travel", "--speed", "--travel-speed",
+      "--accel"}},
 };
 
 // One G-code program's physical content, in mm.
@@ -329,10 +331,11 @@ TEST_F(Units, StreamOptionsAgreeInBothUnits) {
   // The same machine and page in both units (each value exactly 25.4x the
   // other): the plotter makes the very same steps, pin for pin.
   const std::string mm_flags =
-      "--step 0.0127 --speed 50.8 --accel 2540 --margin 12.7 --fit 254x203.2 "
+      "--step 0.0127 --speed 50.8 --travel-speed 101.6 --accel 2540 --margin 12.7 --fit 254x203.2 "
       "--tolerance 0.127 --travel 254x203.2";
   const std::string inch_flags =
-      "--step 0.0005 --speed 2 --accel 100 --margin 0.5 --fit 10x8 --tolerance 0.005 "
+      "--step 0.0005 --speed 2 --travel-speed 4 --accel 100 --margin 0.5 --fit 10x8 --tolerance "
+      "0.005 "
       "--travel 10x8";
   std::string waves[2];
   std::string summaries[2];

@@ -34,7 +34,7 @@ constexpr std::uint32_t kTickHz = 40000;
 motion::TickLimits Limits(std::uint32_t max_rate, std::uint32_t accel,
                           std::uint16_t pen_delay_ms = 0) {
   motion::TickLimits limits{};
-  EXPECT_TRUE(motion::ToTickLimits({kTickHz, max_rate, accel, pen_delay_ms}, &limits));
+  EXPECT_TRUE(motion::ToTickLimits({kTickHz, max_rate, accel, pen_delay_ms, max_rate}, &limits));
   return limits;
 }
 
@@ -79,11 +79,12 @@ double IdealSeconds(double distance, double speed, double accel) {
 
 TEST(MotionLimits, RefusesWhatTheLoopCannotServe) {
   motion::TickLimits limits{};
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kTickHz + 1, 1000, 0}, &limits));  // > 1 step/tick
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 0, 1000, 0}, &limits));
+  EXPECT_FALSE(
+      motion::ToTickLimits({kTickHz, kTickHz + 1, 1000, 0, 1000}, &limits));  // > 1 step/tick
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 0, 1000, 0, 1000}, &limits));
   // 10 steps/s² at 40 kHz is 10·2^24/1.6e9 ≈ 0.1 units per tick²: not representable.
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 1000, 10, 0}, &limits));
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 1000, 10, 0, 1000}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000}, &limits));
   EXPECT_EQ(limits.max_speed, 3355443u);  // 8000·2^24/40000, rounded down
   EXPECT_EQ(limits.accel, 1677u);         // 160000·2^24/40000², rounded down
   EXPECT_EQ(limits.pen_delay_ticks, 4000u);

@@ -56,6 +56,8 @@ MachineOptions Machine(const StreamOptions& o) {
   m.speed = o.speed_limit ? *o.speed_limit : DefaultIn(m.speed, o.units);
   m.accel = o.accel_limit ? *o.accel_limit : DefaultIn(m.accel, o.units);
   if (!(m.speed > 0) || !(m.accel > 0)) throw InputError("--speed and --accel must be above 0");
+  m.travel_speed = o.travel_speed_limit ? *o.travel_speed_limit : m.speed;
+  if (!(m.travel_speed > 0)) throw InputError("--travel-speed must be above 0");
   m.pen_delay_ms = o.pen_delay_ms;
   m.servo_up_us = o.servo_pulse_up_us;
   m.servo_down_us = o.servo_pulse_down_us;
@@ -138,7 +140,7 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
   }
 }
 
-// --step, --travel, --speed and --accel: in --units, the defaults
+// --step, --travel, --speed, --travel-speed and --accel: in --units, the defaults
 // MachineOptions' mm values converted (Machine).
 void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   const MachineOptions mm;  // the defaults, in mm, mm/s and mm/s²
@@ -150,6 +152,8 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
                       "machine travel WxH[xD] in --units (default: the page)");
   command->add_option("--speed", o->speed_limit,
                       "path speed limit, --units per second " + DefaultInMmHelp(mm.speed, "mm/s"));
+  command->add_option("--travel-speed", o->travel_speed_limit,
+                      "path speed limit with the pen up, --units per second (default: --speed)");
   command->add_option(
       "--accel", o->accel_limit,
       "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
@@ -291,6 +295,7 @@ int RunStream(const StreamOptions& options) {
   ToolpathOptions drawing = DrawingOptions(o);
   const MachineOptions machine = Machine(o);
   o.speed = machine.speed;  // for the runners' summaries
+  o.travel_speed = machine.travel_speed;
   o.accel = machine.accel;
   const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");

@@ -43,9 +43,12 @@ struct StreamOptions {
   /// as typed; nullopt when left out: MachineOptions' defaults, which are
   /// mm/s and mm/s², converted to --units.
   std::optional<double> speed_limit;
+  /// --travel-speed, --units per second; unset: --speed.
+  std::optional<double> travel_speed_limit;
   std::optional<double> accel_limit;
   /// The limits in effect, in --units: set by RunStream for the runners.
   double speed = 0;
+  double travel_speed = 0;  ///< pen up; the runners' summaries name it when ≠ speed
   double accel = 0;
   int pen_delay_ms = 100;
   /// The servo pen lift's pulse widths, µs; both 0: a switch pen.

@@ -5,15 +5,18 @@ namespace fdsurf {
 namespace motion {
 
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
-  if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz) {
+  if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz ||
+      limits.travel_rate == 0 || limits.travel_rate > limits.tick_hz) {
     return false;
   }
   const uint64_t hz = limits.tick_hz;
   // Rounded down, so the loop never exceeds the configured figures.
   const uint64_t max_speed = (static_cast<uint64_t>(limits.max_rate) << kLengthFracBits) / hz;
+  const uint64_t travel_speed = (static_cast<uint64_t>(limits.travel_rate) << kLengthFracBits) / hz;
   const uint64_t accel = (static_cast<uint64_t>(limits.accel) << kLengthFracBits) / (hz * hz);
-  if (accel == 0 || accel > max_speed) return false;
+  if (accel == 0 || accel > max_speed || accel > travel_speed) return false;
   out->max_speed = static_cast<uint32_t>(max_speed);
+  out->travel_speed = static_cast<uint32_t>(travel_speed);
   out->accel = static_cast<uint32_t>(accel);
   out->pen_delay_ticks =
       static_cast<uint32_t>(static_cast<uint64_t>(limits.pen_delay_ms) * hz / 1000);
@@ -126,12 +129,16 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
   const uint64_t available = distance_ - phase_;
   const uint32_t a = limits_.accel;
   const uint64_t v = speed_;
+  // Pen down: drawing speed; pen up: travel speed. pen_down_ changes only
+  // where a pen event is passed, at rest, so the profile starts from v = 0
+  // under the new limit and every bound in docs/motion.md holds per run.
+  const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
   uint64_t advance = 0;
-  if (!braking && v + a <= limits_.max_speed && (v + a) + braking_ + v <= available) {
+  if (!braking && v + a <= limit && (v + a) + braking_ + v <= available) {
     braking_ += v;  // B(n+1) = B(n) + n·a
     speed_ += a;
     advance = speed_;
-  } else if (!braking && v + braking_ <= available && v <= limits_.max_speed) {
+  } else if (!braking && v + braking_ <= available && v <= limit) {
     advance = v;
   } else if (v >= a) {
     speed_ -= a;

@@ -121,9 +121,15 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
     config.steps_per_meter[c] = static_cast<std::uint32_t>(std::lround(1 / meters));
   }
   const double max_rate = std::floor(machine.speed / step);
+  const double travel_speed = machine.travel_speed > 0 ? machine.travel_speed : machine.speed;
+  const double travel_rate = std::floor(travel_speed / step);
   const double accel = std::floor(machine.accel / step);
   if (!(max_rate >= 1 && max_rate < 4e9)) {
     throw OptionError("speed", FormatNumber(machine.speed) + " " + units + "/s",
+                      "is not 1 step/s or more");
+  }
+  if (!(travel_rate >= 1 && travel_rate < 4e9)) {
+    throw OptionError("travel speed", FormatNumber(travel_speed) + " " + units + "/s",
                       "is not 1 step/s or more");
   }
   if (!(accel >= 1 && accel < 4e9)) {
@@ -137,10 +143,10 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   config.max_rate = static_cast<std::uint32_t>(max_rate);
   config.accel = static_cast<std::uint32_t>(accel);
   config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
-  // Protocol 3 fields: no separate travel speed or per-axis limit yet, so
-  // the pen-down speed and the path acceleration (what an axis-aligned move
-  // already demands of an axis).
-  config.travel_rate = config.max_rate;
+  // Protocol 3 fields: the pen-up speed limit, and (no per-axis limit yet)
+  // the path acceleration, what an axis-aligned move already demands of an
+  // axis.
+  config.travel_rate = static_cast<std::uint32_t>(travel_rate);
   for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = config.accel;
   SetServoPulses(machine, &config);
   return config;

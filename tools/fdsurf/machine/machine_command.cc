@@ -82,6 +82,7 @@ struct Targets {
       return step.Format(1);
     }
     if (flag == "--travel") return "the page";
+    if (flag == "--travel-speed") return "--speed";
     if (flag == "--tick-hz") return "the device's";
     return "(built in)";
   }

@@ -85,8 +85,11 @@ protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz, bool 
   config.max_rate = static_cast<std::uint32_t>(std::clamp(rate, 1.0, double(tick_hz)));
   config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / s.step)));
   config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
-  // As stream's ConfigFor: no separate travel speed or per-axis limit yet.
-  config.travel_rate = config.max_rate;
+  // Jogs and gotos run with the pen up, so at the travel speed; each axis
+  // gets the path's acceleration, as stream gives it (ConfigFor).
+  const double travel_speed = s.machine.travel_speed > 0 ? s.machine.travel_speed : s.machine.speed;
+  const double travel_rate = std::floor(travel_speed / s.step);
+  config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
   for (int a = 0; a < s.axes; ++a) config.axis_accel[a] = config.accel;
   config.flags = require_homing ? protocol::kConfigFlagHomingRequired : 0;
   return config;

@@ -23,6 +23,13 @@
 namespace fdsurf::host {
 namespace {
 
+// ", travel V units/s" when the pen-up speed limit differs from --speed,
+// else nothing (the summaries then read as before --travel-speed).
+std::string TravelSpeedNote(const StreamOptions& o, const std::string& units) {
+  if (o.travel_speed <= 0 || o.travel_speed == o.speed) return "";
+  return ", travel " + FormatNumber(o.travel_speed) + " " + units + "/s";
+}
+
 // The drawn paths as a toolpath on the job's page, for the writers. A point
 // between two unit moves in the same direction lies on the line through its
 // neighbours: leaving it out draws exactly the same path with far fewer
@@ -153,6 +160,7 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   sim::MotionLimitsSi limits;
   limits.tick_hz = tick_hz;
   limits.max_rate = job.config.max_rate;
+  limits.travel_rate = job.config.travel_rate;
   limits.accel = job.config.accel;
   limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
   checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
@@ -173,6 +181,11 @@ void WriteWaveformFile(const std::string& path, const std::string& name, const S
   header.extra["axes"] = std::to_string(plotter.options().axes);
   header.extra["tick_hz"] = std::to_string(plotter.options().tick_hz);
   header.extra["max_rate"] = std::to_string(job.config.max_rate);
+  // Only when it differs, so a job with one speed writes the same header as
+  // before --travel-speed (the checker takes max_rate when it is absent).
+  if (job.config.travel_rate != job.config.max_rate) {
+    header.extra["travel_rate"] = std::to_string(job.config.travel_rate);
+  }
   header.extra["accel"] = std::to_string(job.config.accel);
   header.extra["pen_delay_ms"] = std::to_string(job.config.pen_delay_ms);
   header.extra["commands"] = std::to_string(job.commands.size());
@@ -254,10 +267,10 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
   // The profile limits the path's acceleration, not each axis's (the
   // centripetal part on curves): the axes' is reported, not checked.
   std::fprintf(stderr,
-               "motion limits (%s %s/s, %s %s/s², pen delay %d ms): %s; axis acceleration %s "
+               "motion limits (%s %s/s%s, %s %s/s², pen delay %d ms): %s; axis acceleration %s "
                "%s/s² (not limited)\n",
-               FormatNumber(o.speed).c_str(), units.c_str(), FormatNumber(o.accel).c_str(),
-               units.c_str(), o.pen_delay_ms, limits.c_str(),
+               FormatNumber(o.speed).c_str(), units.c_str(), TravelSpeedNote(o, units).c_str(),
+               FormatNumber(o.accel).c_str(), units.c_str(), o.pen_delay_ms, limits.c_str(),
                FormatNumber(axis_accel[fastest_axis] * step, 4).c_str(), units.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
   if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
@@ -355,9 +368,9 @@ void PrintDryRun(const StreamOptions& o, const StreamJob& job, std::uint32_t tic
   } else {
     std::printf("page extent drawn: nothing drawn\n");
   }
-  std::printf("commands: %zu; limits %s %s/s, %s %s/s², pen delay %d ms\n", job.commands.size(),
-              FormatNumber(o.speed).c_str(), units, FormatNumber(o.accel).c_str(), units,
-              o.pen_delay_ms);
+  std::printf("commands: %zu; limits %s %s/s%s, %s %s/s², pen delay %d ms\n", job.commands.size(),
+              FormatNumber(o.speed).c_str(), units, TravelSpeedNote(o, units).c_str(),
+              FormatNumber(o.accel).c_str(), units, o.pen_delay_ms);
 }
 
 }  // namespace

@@ -316,22 +316,32 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
     throw DeviceError(device + ": the device drives " + std::to_string(hello.max_axes) +
                       " axes; the job needs " + std::to_string(job.config.axes) + " (--dims)");
   }
-  if (job.config.max_rate <= hello.tick_hz && job.config.travel_rate <= hello.tick_hz) return job;
+  const std::uint32_t tick_hz = hello.tick_hz;
+  if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return job;
   StreamJob fitted = job;
-  const auto fit = [&](protocol::MachineConfig* config) {
-    config->max_rate = std::min(config->max_rate, hello.tick_hz);
-    config->travel_rate = std::min(config->travel_rate, hello.tick_hz);
-  };
-  fit(&fitted.config);
+  fitted.config.max_rate = std::min(job.config.max_rate, tick_hz);
+  fitted.config.travel_rate = std::min(job.config.travel_rate, tick_hz);
   for (protocol::Command& command : fitted.commands) {
-    if (command.type == protocol::MessageType::kConfig) fit(&command.body.config);
+    if (command.type != protocol::MessageType::kConfig) continue;
+    command.body.config.max_rate = fitted.config.max_rate;
+    command.body.config.travel_rate = fitted.config.travel_rate;
   }
-  if (!o.quiet && job.config.max_rate > hello.tick_hz) {
-    const double lowered = o.speed * hello.tick_hz / job.config.max_rate;
+  if (o.quiet) return fitted;
+  if (job.config.max_rate > tick_hz) {
+    const double lowered = o.speed * tick_hz / job.config.max_rate;
     std::fprintf(stderr,
                  "fdsurf: note: %s ticks at %u Hz, one step per tick at most: the speed limit is "
                  "lowered from %u to %u steps/s (--speed %g %s/s becomes %.4g %s/s)\n",
-                 device.c_str(), hello.tick_hz, job.config.max_rate, hello.tick_hz, o.speed,
+                 device.c_str(), tick_hz, job.config.max_rate, tick_hz, o.speed, o.units.c_str(),
+                 lowered, o.units.c_str());
+  }
+  // The pen-up limit is only named when --travel-speed made it differ.
+  if (job.config.travel_rate > tick_hz && job.config.travel_rate != job.config.max_rate) {
+    const double lowered = o.travel_speed * tick_hz / job.config.travel_rate;
+    std::fprintf(stderr,
+                 "fdsurf: note: %s ticks at %u Hz: the pen-up speed limit is lowered from %u to "
+                 "%u steps/s (--travel-speed %g %s/s becomes %.4g %s/s)\n",
+                 device.c_str(), tick_hz, job.config.travel_rate, tick_hz, o.travel_speed,
                  o.units.c_str(), lowered, o.units.c_str());
   }
   return fitted;

@@ -127,9 +127,9 @@ StreamJob JobWithJournal(const StreamOptions& o, const StreamJob& job, const Str
 std::uint32_t Milliseconds(double seconds);
 
 /// The job as the device can run it: a device that ticks slower than the
-/// job's speed needs (max_rate steps/s over HELLO's tick_hz) gets the speed
-/// limit lowered to its tick rate, with a note on stderr (unless quiet) that
-/// names the device and both speeds. DeviceError when the device drives
+/// job's speed needs (max_rate or travel_rate steps/s over HELLO's tick_hz)
+/// gets that speed limit lowered to its tick rate, with a note on stderr
+/// (unless quiet) that names the device and both speeds. DeviceError when the device drives
 /// fewer axes than the job needs.
 StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello,
                          const std::string& device, const StreamOptions& o);

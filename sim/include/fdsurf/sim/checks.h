@@ -42,8 +42,10 @@ DrawingComparison CompareDrawing(const std::vector<DrawnPath>& drawn,
 /// The limits a run must keep, in steps and seconds.
 struct MotionLimitsSi {
   std::uint32_t tick_hz = 40000;
-  double max_rate = 0;  ///< path speed, steps/s
-  double accel = 0;     ///< path acceleration, steps/s²
+  double max_rate = 0;  ///< path speed with the pen down, steps/s
+  /// Path speed with the pen up (travel), steps/s; 0: the same as max_rate.
+  double travel_rate = 0;
+  double accel = 0;  ///< path acceleration, steps/s²
   /// Acceleration of each axis on its own (the centripetal part on curves
   /// included), steps/s²; 0: measured but not checked.
   double axis_accel = 0;
@@ -55,6 +57,10 @@ struct MotionReport {
   double min_axis_interval_us = 0;
   /// Fastest path speed over any window of `window_s`, steps/s.
   double max_speed = 0;
+  /// The same over windows wholly within one pen-down run, and within one
+  /// pen-up run (between two rests at pen changes), steps/s.
+  double max_draw_speed = 0;
+  double max_travel_speed = 0;
   /// Largest change of the windowed speed between neighbouring windows,
   /// divided by the window: steps/s².
   double max_accel = 0;
@@ -62,7 +68,8 @@ struct MotionReport {
   /// (signed steps, so a reversal counts) between neighbouring windows,
   /// divided by the window: steps/s².
   std::array<double, 3> max_axis_accel{};
-  /// Violations of: the per-axis step interval, the speed limit, the
+  /// Violations of: the per-axis step interval, the speed limit (max_rate
+  /// with the pen down, travel_rate with it up), the
   /// start-from-rest and stop-at-rest acceleration laws, the pen delay, the
   /// windowed acceleration of the path and (when `axis_accel` is set) of
   /// each axis (each with the quantisation allowance in docs/motion.md).

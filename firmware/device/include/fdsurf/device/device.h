@@ -250,10 +250,12 @@ class Device {
       }
       motion::TickLimits limits;
       if (!motion::ToTickLimits(LimitsOf(config), &limits)) {
-        *detail = config.max_rate > tick_hz_ ? protocol::kConfigFieldMaxRate
-                                             : protocol::kConfigFieldAccel;
+        *detail = config.max_rate > tick_hz_      ? protocol::kConfigFieldMaxRate
+                  : config.travel_rate > tick_hz_ ? protocol::kConfigFieldTravelRate
+                                                  : protocol::kConfigFieldAccel;
         return protocol::ErrorCode::kBadField;
       }
+      if (!AxisAccelRepresentable(config, detail)) return protocol::ErrorCode::kBadField;
       // A travel over kMaxPlannableTravelSteps would allow moves the engine
       // cannot plan: refused here, so that no accepted move can fault.
       uint8_t axis = 0;
@@ -389,7 +391,26 @@ class Device {
 
  private:
   FDSURF_NODISCARD motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
-    return motion::MotionLimits{tick_hz_, config.max_rate, config.accel, config.pen_delay_ms};
+    return motion::MotionLimits{tick_hz_, config.max_rate, config.accel, config.pen_delay_ms,
+                                config.travel_rate};
+  }
+
+  // Each used axis's acceleration limit must be at least 2^-24 steps per
+  // tick², as ToTickLimits() requires of the path's: a smaller one rounds
+  // to zero at this tick rate. (The loop does not act on it yet; refusing
+  // now keeps a configuration that a later device would refuse from being
+  // accepted today.) false: *detail names the field (11..13).
+  bool AxisAccelRepresentable(const protocol::MachineConfig& config, uint8_t* detail) const {
+    const uint64_t hz = tick_hz_;
+    for (int a = 0; a < config.axes && a < protocol::kMaxAxes; ++a) {
+      const uint64_t per_tick =
+          (static_cast<uint64_t>(config.axis_accel[a]) << motion::kLengthFracBits) / (hz * hz);
+      if (per_tick == 0) {
+        *detail = static_cast<uint8_t>(protocol::kConfigFieldAxisAccel + a);
+        return false;
+      }
+    }
+    return true;
   }
 
   void ResetState() {

@@ -37,26 +37,32 @@ namespace motion {
 struct MotionLimits {
   /// Ticks per second of the step timer.
   uint32_t tick_hz;
-  /// Largest path speed, steps per second; ≤ tick_hz.
+  /// Largest path speed with the pen down, steps per second; ≤ tick_hz.
   uint32_t max_rate;
   /// Path acceleration, steps per second².
   uint32_t accel;
   /// Rest after a pen change, milliseconds.
   uint16_t pen_delay_ms;
+  /// Largest path speed with the pen up (travel), steps per second; ≤ tick_hz.
+  uint32_t travel_rate;
 };
 
 /// The same limits per tick, as the loop uses them.
 struct TickLimits {
-  /// Largest speed, 2^-24 steps per tick (≤ 2^24: one unit move per tick).
+  /// Largest speed with the pen down, 2^-24 steps per tick (≤ 2^24: one
+  /// unit move per tick).
   uint32_t max_speed;
   /// Acceleration, 2^-24 steps per tick², ≥ 1, rounded down (conservative).
   uint32_t accel;
   uint32_t pen_delay_ticks;
+  /// Largest speed with the pen up, 2^-24 steps per tick (≤ 2^24).
+  uint32_t travel_speed;
 };
 
 /// Converts limits to per-tick units. Returns false when they cannot be
-/// served: max_rate of 0 or above tick_hz, or an acceleration below
-/// 2^-24 steps per tick² (too small to represent at this tick rate).
+/// served: max_rate or travel_rate of 0 or above tick_hz, or an
+/// acceleration below 2^-24 steps per tick² (too small to represent at this
+/// tick rate) or above either speed limit per tick.
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out);
 
 /// What one tick did.
@@ -77,6 +83,9 @@ class MotionLoop {
   MotionLoop(uint8_t* storage, uint16_t capacity);
 
   /// Sets the limits used from now on; call only when AtRest() and Empty().
+  /// The speed limit is limits.max_speed while the pen is down and
+  /// limits.travel_speed while it is up; it changes only where the loop
+  /// passes a pen event, which it always does at rest (docs/motion.md).
   void Configure(const TickLimits& limits) { limits_ = limits; }
   FDSURF_NODISCARD const TickLimits& limits() const { return limits_; }
 
@@ -160,7 +169,7 @@ class MotionLoop {
   /// Distance needed to come to rest from speed_: a·n(n−1)/2.
   uint64_t braking_ = 0;
   uint32_t pen_wait_ = 0;
-  TickLimits limits_ = {0, 1, 0};
+  TickLimits limits_ = {0, 1, 0, 0};
   int32_t position_[3] = {0, 0, 0};
   uint32_t moves_ = 0;
   bool pen_down_ = false;

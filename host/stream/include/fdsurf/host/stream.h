@@ -32,6 +32,9 @@ struct MachineOptions {
   /// Path speed and acceleration limits.
   double speed = 100;
   double accel = 2000;
+  /// Path speed limit with the pen up (the device's CONFIG travel_rate);
+  /// 0: the same as `speed`.
+  double travel_speed = 0;
   int pen_delay_ms = 100;
   /// A hobby-servo pen lift's pulse widths, µs (the device's CONFIG
   /// servo_up_us/servo_down_us): both 0 for a plain switch pen, else each
