@@ -21,7 +21,9 @@ struct FakeGpioLine {
   int set_errno = 0;       // non-zero: gpiod_line_set_value fails with it
   int set_fails_for = -1;  // with set_errno: only setting this value fails (-1: any)
   bool requested = false;
-  int value = -1;
+  bool input = false;  // requested as an input (gpiod_line_request_input)
+  int value = -1;      // an output's last value, or the level an input reads
+  int get_errno = 0;   // non-zero: gpiod_line_get_value fails with it
 };
 
 struct FakeGpioChip {
@@ -34,7 +36,8 @@ struct FakeGpio {
   std::map<std::string, FakeGpioChip> chips;
   /// errno of a lookup of a descriptor not in `chips`.
   int missing_errno = 2;  // ENOENT
-  /// "lookup gpiochip0", "request 17 fdsurf 0", "set 17=1", "release 17", "close".
+  /// "lookup gpiochip0", "request 17 fdsurf 0", "input 5 fdsurf", "set 17=1",
+  /// "release 17", "close" (reads of inputs are not logged).
   std::vector<std::string> log;
   /// When each "set" entry happened (CLOCK_MONOTONIC µs), parallel to the sets in `log`.
   std::vector<uint64_t> set_times_us;
