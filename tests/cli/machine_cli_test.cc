@@ -247,5 +247,22 @@ TEST_F(MachineCli, MachineShowPrintsTheHomingSettingsAndTheirSource) {
   EXPECT_NE(defaults.out.find("homing.axes  all"), std::string::npos) << defaults.out;
 }
 
+// The gpio device's ENDSTOPS part is checked before any line is opened:
+// a bad one is bad input (exit 2) naming the switch, a good one gets as far
+// as opening the chip (none on this machine: exit 3).
+TEST_F(MachineCli, GpioEndstopsAreCheckedBeforeAnyLineIsOpened) {
+  const std::string stream = "stream '" + kTeapot + "' --lines 2 --quiet --device ";
+  const RunResult reused = Run(stream + "'gpio:gpiochip0:17,27,22,23,24,25:xmin=24'");
+  EXPECT_EQ(reused.exit_code, 2);
+  EXPECT_EQ(reused.err,
+            "fdsurf: error: --device: endstop xmin: line 24 is also an output in LINES\n");
+  const RunResult unknown = Run(stream + "'gpio:gpiochip0:17,27,22,23,24,25:xmin=!5,xlim=6'");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("endstop 'xlim=6' is not AXISEND"), std::string::npos) << unknown.err;
+  const RunResult good = Run(stream + "'gpio:fdsurf-no-chip:17,27,22,23,24,25:xmin=!5,ymin=!6'");
+  EXPECT_EQ(good.exit_code, 3) << good.err;
+  EXPECT_NE(good.err.find("fdsurf-no-chip"), std::string::npos) << good.err;
+}
+
 }  // namespace
 }  // namespace fdsurf::test_support

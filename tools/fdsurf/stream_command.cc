@@ -183,7 +183,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->add_option("--device", o->device,
                    "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
                    "serial:PATH[:BAUD] (e.g. serial:/dev/ttyACM0:115200), serial:auto or "
-                   "gpio:CHIP:STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN")
+                   "gpio:CHIP:STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN[:xmin=!N,ymin=!N,...]")
       ->capture_default_str();
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")
