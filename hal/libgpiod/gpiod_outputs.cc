@@ -96,7 +96,13 @@ bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* er
     *error = "gpio device " + quoted + " must start with 'gpio:'; " + usage;
     return false;
   }
-  const std::string_view rest = spec.substr(5);
+  std::string_view rest = spec.substr(5);
+  std::string endstops;
+  if (const size_t last = rest.rfind(':');
+      last != std::string_view::npos && rest.substr(last).find('=') != std::string_view::npos) {
+    endstops = std::string(rest.substr(last + 1));  // ENDSTOPS, gpiod_inputs.h
+    rest = rest.substr(0, last);
+  }
   const size_t colon = rest.rfind(':');
   if (colon == std::string_view::npos || colon == 0) {
     *error = "gpio device " + quoted + " has no " + (colon == 0 ? "CHIP" : "LINES") + "; " + usage;
@@ -118,6 +124,7 @@ bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* er
   }
   GpiodConfig parsed = *config;
   parsed.chip = std::string(chip);
+  parsed.endstops = endstops;
   parsed.axes = fields.size() == 8 ? 3 : 2;
   std::vector<std::pair<unsigned, const char*>> used;
   auto take = [&](std::string_view field, const char* name, bool active_low, GpioLine* line) {

@@ -143,6 +143,30 @@ int __wrap_gpiod_line_set_value(gpiod_line* line, int value) {
   return 0;
 }
 
+int __wrap_gpiod_line_request_input(gpiod_line* line, const char* consumer) {
+  if (Line(line)->request_errno != 0) {
+    errno = Line(line)->request_errno;
+    return -1;
+  }
+  g_fake_gpio->log.push_back("input " + std::to_string(Line(line)->offset) + " " + consumer);
+  Line(line)->requested = true;
+  Line(line)->input = true;
+  if (Line(line)->value < 0) Line(line)->value = 0;
+  return 0;
+}
+
+int __wrap_gpiod_line_get_value(gpiod_line* line) {
+  if (!Line(line)->requested) {
+    errno = EPERM;
+    return -1;
+  }
+  if (Line(line)->get_errno != 0) {
+    errno = Line(line)->get_errno;
+    return -1;
+  }
+  return Line(line)->value;
+}
+
 void __wrap_gpiod_line_release(gpiod_line* line) {
   g_fake_gpio->log.push_back("release " + std::to_string(Line(line)->offset));
   Line(line)->requested = false;

@@ -24,7 +24,9 @@ struct FakeGpioLine {
   /// Which request holds the line (lines requested together share one,
   /// as they share one file descriptor in libgpiod); 0 when not requested.
   int request = 0;
-  int value = -1;
+  bool input = false;  // requested as an input (gpiod_line_request_input)
+  int value = -1;      // an output's last value, or the level an input reads
+  int get_errno = 0;   // non-zero: gpiod_line_get_value fails with it
 };
 
 struct FakeGpioChip {
@@ -37,9 +39,9 @@ struct FakeGpio {
   std::map<std::string, FakeGpioChip> chips;
   /// errno of a lookup of a descriptor not in `chips`.
   int missing_errno = 2;  // ENOENT
-  /// "lookup gpiochip0", "request 17 fdsurf 0", "set 17=1", "release 17", "close";
-  /// lines requested or set in one bulk call: "request 17,22 fdsurf 0,0",
-  /// "set 17=1,22=0".
+  /// "lookup gpiochip0", "request 17 fdsurf 0", "input 5 fdsurf", "set 17=1",
+  /// "release 17", "close"; lines requested or set in one bulk call:
+  /// "request 17,22 fdsurf 0,0", "set 17=1,22=0" (reads of inputs are not logged).
   std::vector<std::string> log;
   /// When each "set" entry happened (CLOCK_MONOTONIC µs), parallel to the sets in `log`.
   std::vector<uint64_t> set_times_us;

@@ -176,5 +176,93 @@ TEST_F(MachineCli, BadProfileStopsTheCommandBeforeAnythingIsDrawn) {
   EXPECT_NE(missing.err.find("no profile file"), std::string::npos) << missing.err;
 }
 
+// The profile's [homing] table drives `machine home`; its flags override it.
+TEST_F(MachineCli, MachineHomeTakesTheProfilesHomingTable) {
+  const std::string p = Write("h.toml",
+                              "travel = [100, 80]\n[homing]\naxes = \"x\"\nrate = 4\n"
+                              "backoff = 2\n");
+  const RunResult r = Run("machine home --machine '" + p + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The sim carriage stops `backoff` from the switch it homed against; Y
+  // (not homed) stays a quarter of the travel away.
+  EXPECT_NE(r.out.find("the carriage stands x 2, y 20 mm from its min switches"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("homed x;"), std::string::npos) << r.out;
+  const RunResult flags = Run("machine home --machine '" + p + "' --axes xy --backoff 1.5");
+  ASSERT_EQ(flags.exit_code, 0) << flags.err;
+  EXPECT_NE(flags.out.find("stands x 1.5, y 1.5 mm"), std::string::npos) << flags.out;
+  EXPECT_NE(flags.out.find("homed xy;"), std::string::npos) << flags.out;
+  // A rate the device cannot step names the profile's key and line.
+  const std::string fast = Write("fast.toml", "travel = [100, 80]\n[homing]\nrate = 900\n");
+  const RunResult refused = Run("machine home --machine '" + fast + "'");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("homing.rate (" + fast + ":3): 900 mm/s is not between"),
+            std::string::npos)
+      << refused.err;
+  // One direction per axis: two for a 2-axis machine, not three.
+  const RunResult three = Run("machine home --machine '" + p + "' --toward min,min,max");
+  EXPECT_EQ(three.exit_code, 2);
+  EXPECT_NE(three.err.find("--toward: 'min,min,max' gives 3 directions for 2 axes"),
+            std::string::npos)
+      << three.err;
+}
+
+TEST_F(MachineCli, BadHomingTableStopsMachineHome) {
+  const std::string p = Write("h.toml", "travel = [100, 80]\n[homing]\ntoward = \"left\"\n");
+  const RunResult r = Run("machine home --machine '" + p + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "fdsurf: error: " + p +
+                       ":3:10: key 'homing.toward': must be \"min\" or \"max\", not \"left\"\n");
+}
+
+// homing.required puts CONFIG's flag on the stream: the simulated device,
+// never homed, refuses the first motion and the message says what to do.
+TEST_F(MachineCli, StreamOnAMachineThatRequiresHomingSaysToHome) {
+  const std::string p = Write("h.toml", "[homing]\nrequired = true\n");
+  const RunResult r = Run("stream '" + kTeapot + "' --lines 2 --quiet --machine '" + p + "'");
+  EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
+  EXPECT_NE(r.err.find("not homed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("run `fdsurf machine home`"), std::string::npos) << r.err;
+  const RunResult plain = Run("stream '" + kTeapot + "' --lines 2 --quiet");
+  EXPECT_EQ(plain.exit_code, 0) << plain.err;
+  const RunResult flag = Run("stream '" + kTeapot + "' --lines 2 --quiet --require-homing");
+  EXPECT_EQ(flag.exit_code, 3) << flag.err;
+}
+
+TEST_F(MachineCli, MachineShowPrintsTheHomingSettingsAndTheirSource) {
+  const RunResult r = Run("machine show --machine '" + kMachines + "/ramps.toml' --rate 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("homing.rate  3                    mm/s       --rate         command line"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("homing.toward min"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("false                -          --require-homing profile " + kMachines +
+                       "/ramps.toml:"),
+            std::string::npos)
+      << r.out;
+  const RunResult defaults = Run("machine show");
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  EXPECT_NE(defaults.out.find("homing.backoff 1 "), std::string::npos) << defaults.out;
+  EXPECT_NE(defaults.out.find("homing.axes  all"), std::string::npos) << defaults.out;
+}
+
+// The gpio device's ENDSTOPS part is checked before any line is opened:
+// a bad one is bad input (exit 2) naming the switch, a good one gets as far
+// as opening the chip (none on this machine: exit 3).
+TEST_F(MachineCli, GpioEndstopsAreCheckedBeforeAnyLineIsOpened) {
+  const std::string stream = "stream '" + kTeapot + "' --lines 2 --quiet --device ";
+  const RunResult reused = Run(stream + "'gpio:gpiochip0:17,27,22,23,24,25:xmin=24'");
+  EXPECT_EQ(reused.exit_code, 2);
+  EXPECT_EQ(reused.err,
+            "fdsurf: error: --device: endstop xmin: line 24 is also an output in LINES\n");
+  const RunResult unknown = Run(stream + "'gpio:gpiochip0:17,27,22,23,24,25:xmin=!5,xlim=6'");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("endstop 'xlim=6' is not AXISEND"), std::string::npos) << unknown.err;
+  const RunResult good = Run(stream + "'gpio:fdsurf-no-chip:17,27,22,23,24,25:xmin=!5,ymin=!6'");
+  EXPECT_EQ(good.exit_code, 3) << good.err;
+  EXPECT_NE(good.err.find("fdsurf-no-chip"), std::string::npos) << good.err;
+}
+
 }  // namespace
 }  // namespace fdsurf::test_support

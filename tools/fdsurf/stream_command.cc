@@ -61,6 +61,7 @@ MachineOptions Machine(const StreamOptions& o) {
   m.pen_delay_ms = o.pen_delay_ms;
   m.servo_up_us = o.servo_pulse_up_us;
   m.servo_down_us = o.servo_pulse_down_us;
+  m.homing_required = o.require_homing;
   return m;
 }
 
@@ -135,7 +136,12 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
         return RunGpio(real, job);
     }
   } catch (const DeviceError& e) {
-    std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
+    const std::string message = e.what();
+    const bool not_homed = message.find("not homed") != std::string::npos;
+    std::fprintf(stderr, "fdsurf: error: %s%s\n", message.c_str(),
+                 not_homed ? " (the machine requires homing: run `fdsurf machine home` with the "
+                             "same --machine/--device first)"
+                           : "");
     return 3;
   }
 }
@@ -157,6 +163,8 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   command->add_option(
       "--accel", o->accel_limit,
       "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+  command->add_flag("--require-homing", o->require_homing,
+                    "the device refuses to move until homed: run `fdsurf machine home` first");
 }
 
 // --journal and --resume (runners/journal.h).
@@ -179,7 +187,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->add_option("--device", o->device,
                    "sim (the simulated plotter), usb[:VID:PID|:BUS-PORT.PORT], "
                    "serial:PATH[:BAUD] (e.g. serial:/dev/ttyACM0:115200), serial:auto or "
-                   "gpio:CHIP:STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN")
+                   "gpio:CHIP:STEPX,DIRX,STEPY,DIRY[,STEPZ,DIRZ],EN,PEN[:xmin=!N,ymin=!N,...]")
       ->capture_default_str();
   command
       ->add_option("--lines", o->lines, "isolines per patch: U (UxU) or UxV, 0 leaves a family out")

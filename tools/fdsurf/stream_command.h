@@ -54,6 +54,8 @@ struct StreamOptions {
   /// The servo pen lift's pulse widths, µs; both 0: a switch pen.
   int servo_pulse_up_us = 0;
   int servo_pulse_down_us = 0;
+  /// --require-homing: CONFIG's homing-required flag (MachineOptions).
+  bool require_homing = false;
   std::uint32_t tick_hz = 0;
   // The link and the simulator.
   std::uint64_t link_bytes_per_second = 1'000'000;

@@ -86,7 +86,9 @@ TEST(MachineProfile, UnknownKeyIsRefusedWithTheNearestKnownOne) {
 }
 
 TEST(MachineProfile, KeysOfFeaturesToComeSaySo) {
-  EXPECT_EQ(RefusalOf("homing = true\n"), "m.toml:1:1: key 'homing': homing is not supported yet");
+  EXPECT_NE(RefusalOf("home = true\n").find("key 'home': the key is 'homing', a table"),
+            std::string::npos);
+  EXPECT_NE(RefusalOf("origin = [0, 0]\n").find("not supported yet"), std::string::npos);
   EXPECT_NE(RefusalOf("accel_x = 3\n").find("not supported yet"), std::string::npos);
   EXPECT_NE(RefusalOf("steps_per_mm = 80\n").find("not supported yet"), std::string::npos);
 }
@@ -109,6 +111,65 @@ TEST(MachineProfile, OutOfRangeIsRefused) {
   EXPECT_EQ(RefusalOf("units = \"cm\"\n"),
             "m.toml:1:9: key 'units': must be \"mm\" or \"in\", not \"cm\"");
   EXPECT_EQ(RefusalOf("speed = 100\nfeed = 1200\n"), "");
+}
+
+TEST(MachineProfile, HomingTableGivesItsKeysWithTheirLines) {
+  const MachineProfile p = ParseMachineProfile(
+      "speed = 20\n[homing]\naxes = \"xy\"\ntoward = [\"min\", \"max\"]\nrate = 4\n"
+      "backoff = 0\nrequired = true\n",
+      "m.toml");
+  ASSERT_EQ(p.values.size(), 6U);
+  const ProfileValue* toward = p.Find("homing.toward");
+  ASSERT_NE(toward, nullptr);
+  EXPECT_EQ(toward->text, "min,max");
+  EXPECT_EQ(toward->line, 4);
+  EXPECT_EQ(OptionText(p, *p.Find("homing.rate"), "mm"), "4");
+  EXPECT_EQ(OptionText(p, *p.Find("homing.backoff"), "mm"), "0");
+  EXPECT_EQ(OptionText(p, *p.Find("homing.required"), "mm"), "true");
+  EXPECT_EQ(p.Find("homing.axes")->text, "xy");
+  EXPECT_EQ(ParseMachineProfile("[homing]\ntoward = \"max\"\n", "m.toml").values[0].text, "max");
+  // In inches the lengths convert as the others do.
+  const MachineProfile in = ParseMachineProfile("units = \"in\"\n[homing]\nrate = 0.5\n", "m");
+  EXPECT_EQ(OptionText(in, in.values[0], "mm"), "12.7");
+}
+
+TEST(MachineProfile, HomingTableRefusesWithFileLineAndKey) {
+  EXPECT_EQ(RefusalOf("[homing]\n rat = 3\n"),
+            "m.toml:2:2: key 'homing.rat': not a machine setting (did you mean 'rate'? "
+            "docs/machines.md lists them)");
+  EXPECT_NE(RefusalOf("[homing]\nbakoff = 3\n").find("did you mean 'backoff'"), std::string::npos);
+  EXPECT_EQ(RefusalOf("[homing]\ntoward = \"up\"\n"),
+            "m.toml:2:10: key 'homing.toward': must be \"min\" or \"max\", not \"up\"");
+  EXPECT_NE(RefusalOf("[homing]\ntoward = [\"min\", 3]\n").find("must be a string or an array"),
+            std::string::npos);
+  EXPECT_NE(RefusalOf("[homing]\naxes = \"xq\"\n").find("key 'homing.axes': must name the axes"),
+            std::string::npos);
+  EXPECT_NE(RefusalOf("[homing]\naxes = \"xx\"\n").find("distinct letters"), std::string::npos);
+  EXPECT_EQ(RefusalOf("[homing]\nbackoff = -1\n"),
+            "m.toml:2:11: key 'homing.backoff': must be 0 or more, not -1");
+  EXPECT_EQ(RefusalOf("[homing]\nrate = 0\n"),
+            "m.toml:2:8: key 'homing.rate': must be above 0, not 0");
+  EXPECT_EQ(RefusalOf("[homing]\nrequired = \"yes\"\n"),
+            "m.toml:2:12: key 'homing.required': must be true or false, not string");
+  EXPECT_NE(RefusalOf("homing = true\n").find("key 'homing': must be a table"), std::string::npos);
+  // The table's keys are not top-level keys.
+  EXPECT_NE(RefusalOf("backoff = 1\n").find("not a machine setting"), std::string::npos);
+  EXPECT_NE(RefusalOf("\"homing.rate\" = 1\n").find("not a machine setting"), std::string::npos);
+}
+
+TEST(MachineProfile, HomingRequiredSetsTheFlagUnlessTheCommandLineGaveIt) {
+  CLI::App app;
+  bool required = false;
+  app.add_flag("--require-homing", required);
+  app.parse(std::vector<std::string>{});
+  ApplyMachineProfile(ParseMachineProfile("[homing]\nrequired = true\n", "m.toml"), &app);
+  EXPECT_TRUE(required);
+  CLI::App given;
+  bool given_required = false;
+  given.add_flag("--require-homing", given_required);
+  given.parse(std::vector<std::string>{"--require-homing"});
+  ApplyMachineProfile(ParseMachineProfile("[homing]\nrequired = false\n", "m.toml"), &given);
+  EXPECT_TRUE(given_required);
 }
 
 // A command with a few of stream's and plot's options, as they declare them.

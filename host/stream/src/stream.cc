@@ -149,6 +149,7 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   config.travel_rate = static_cast<std::uint32_t>(travel_rate);
   for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = config.accel;
   SetServoPulses(machine, &config);
+  config.flags = machine.homing_required ? protocol::kConfigFlagHomingRequired : 0;
   return config;
 }
 

@@ -81,6 +81,12 @@ struct Targets {
       const Quantum step = DefaultStepIn(machine.step, units);
       return step.Format(1);
     }
+    // machine home's defaults (manual_command.cc).
+    if (flag == "--rate") return FormatNumber(DefaultIn(5, units));
+    if (flag == "--backoff") return FormatNumber(DefaultIn(1, units));
+    if (flag == "--axes") return "all";
+    if (flag == "--toward") return "min";
+    if (flag == "--require-homing") return "false";
     if (flag == "--travel") return "the page";
     if (flag == "--travel-speed") return "--speed";
     if (flag == "--tick-hz") return "the device's";
@@ -116,7 +122,11 @@ void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
   options->values.resize(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
     if (keys[i].option[0] == '\0') continue;
-    command->add_option(keys[i].option, options->values[i], keys[i].help);
+    if (keys[i].type == KeyType::kBool) {
+      command->add_flag(keys[i].option, options->values[i], keys[i].help);
+    } else {
+      command->add_option(keys[i].option, options->values[i], keys[i].help);
+    }
   }
 }
 

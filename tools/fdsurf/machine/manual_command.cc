@@ -8,6 +8,8 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,7 +35,8 @@ struct Settings {
   StreamOptions stream;
   MachineOptions machine;
   int axes = 2;
-  double step = 0;  // in stream.units
+  double step = 0;         // in stream.units
+  MachineProfile profile;  // --machine's (no values without it)
 };
 
 void GiveOption(CLI::App* command, const std::string& flag, const std::string& value) {
@@ -57,7 +60,11 @@ Settings Resolve(const ManualOptions& o) {
   for (const auto& [flag, value] : given) {
     if (!value->empty()) GiveOption(stream, flag, *value);
   }
-  ApplyMachineOption(o.machine, stream);
+  if (o.require_homing) GiveOption(stream, "--require-homing", "true");
+  if (!o.machine.empty()) {
+    s.profile = LoadMachineProfile(FindMachineProfile(o.machine));
+    ApplyMachineProfile(s.profile, stream);
+  }
   s.machine = StreamMachine(s.stream);
   if (!(s.machine.travel[0] > 0)) {
     throw InputError(
@@ -73,7 +80,7 @@ std::int32_t ToSteps(double length, double step) {
   return static_cast<std::int32_t>(std::floor(length / step + 1e-9));
 }
 
-protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz, bool require_homing) {
+protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz) {
   protocol::MachineConfig config{};
   config.axes = static_cast<std::uint8_t>(s.axes);
   const double meters = s.step * (s.stream.units == "in" ? 0.0254 : 0.001);
@@ -91,7 +98,7 @@ protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz, bool 
   const double travel_rate = std::floor(travel_speed / s.step);
   config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
   for (int a = 0; a < s.axes; ++a) config.axis_accel[a] = config.accel;
-  config.flags = require_homing ? protocol::kConfigFlagHomingRequired : 0;
+  config.flags = s.stream.require_homing ? protocol::kConfigFlagHomingRequired : 0;
   return config;
 }
 
@@ -235,29 +242,82 @@ std::uint8_t AxisMask(const std::string& letters, int axes, const char* flag) {
   return mask;
 }
 
+// One homing setting as `home` uses it: the command line's flag, else the
+// profile's [homing] key, else empty; `what` names where it came from.
+struct HomingSetting {
+  std::string text;
+  std::string what;
+};
+
+HomingSetting HomingValue(const Settings& s, const char* flag, const std::string& given,
+                          const char* key) {
+  if (!given.empty()) return {given, flag};
+  const ProfileValue* value = s.profile.Find(key);
+  if (value == nullptr) return {"", flag};
+  return {OptionText(s.profile, *value, s.stream.units),
+          std::string(key) + " (" + SourceOf(s.profile, *value) + ")"};
+}
+
+// --toward / homing.toward: "min" or "max" for every homed axis, or one per
+// machine axis ("min,max" on the command line, ["min", "max"] in a profile).
+std::uint8_t TowardMaxMask(const HomingSetting& toward, const Settings& s, std::uint8_t axes) {
+  if (toward.text.empty()) return 0;
+  std::vector<std::string> items;
+  std::stringstream list(toward.text);
+  for (std::string item; std::getline(list, item, ',');) items.push_back(item);
+  if (items.size() != 1 && items.size() != static_cast<std::size_t>(s.axes)) {
+    throw InputError(toward.what + ": '" + toward.text + "' gives " + std::to_string(items.size()) +
+                     " directions for " + std::to_string(s.axes) +
+                     " axes (give one for all, or one per axis)");
+  }
+  std::uint8_t mask = 0;
+  for (int a = 0; a < s.axes; ++a) {
+    const std::string& item = items[items.size() == 1 ? 0 : static_cast<std::size_t>(a)];
+    if (item != "min" && item != "max") {
+      throw InputError(toward.what + ": '" + item + "' is not min or max");
+    }
+    if (item == "max") mask = static_cast<std::uint8_t>(mask | 1u << a);
+  }
+  return static_cast<std::uint8_t>(mask & axes);
+}
+
+// A length of the homing settings: the flag's, else the profile's, else
+// `default_mm` in the command's units.
+double HomingLength(const Settings& s, const std::optional<double>& given, const char* flag,
+                    const char* key, double default_mm, std::string* what) {
+  *what = flag;
+  if (given) return *given;
+  const HomingSetting value = HomingValue(s, flag, "", key);
+  if (value.text.empty()) return DefaultIn(default_mm, s.stream.units);
+  *what = value.what;
+  return std::stod(value.text);
+}
+
 protocol::Command HomeOf(const ManualOptions& o, const Settings& s,
                          const protocol::MachineConfig& config, std::uint32_t tick_hz) {
   protocol::Command command;
   command.type = protocol::MessageType::kHome;
   protocol::HomeCommand& home = command.body.home;
-  home.axes =
-      AxisMask(o.axes.empty() ? std::string(kAxisLetters, s.axes) : o.axes, s.axes, "--axes");
-  if (!o.toward.empty() && o.toward != "min" && o.toward != "max") {
-    throw InputError("--toward: '" + o.toward + "' is not min or max");
-  }
-  home.toward_max = o.toward == "max" ? home.axes : 0;
-  const double rate = o.rate ? *o.rate : DefaultIn(5, s.stream.units);
-  const double backoff = o.backoff ? *o.backoff : DefaultIn(1, s.stream.units);
+  const HomingSetting axes = HomingValue(s, "--axes", o.axes, "homing.axes");
+  home.axes = AxisMask(axes.text.empty() ? std::string(kAxisLetters, s.axes) : axes.text, s.axes,
+                       axes.what.c_str());
+  home.toward_max =
+      TowardMaxMask(HomingValue(s, "--toward", o.toward, "homing.toward"), s, home.axes);
+  std::string rate_from;
+  std::string backoff_from;
+  const double rate = HomingLength(s, o.rate, "--rate", "homing.rate", 5, &rate_from);
+  const double backoff =
+      HomingLength(s, o.backoff, "--backoff", "homing.backoff", 1, &backoff_from);
   const double rate_steps = std::floor(rate / s.step);
   if (!(rate_steps >= 1 && rate_steps <= tick_hz)) {
-    throw InputError("--rate: " + FormatNumber(rate) + " " + s.stream.units +
+    throw InputError(rate_from + ": " + FormatNumber(rate) + " " + s.stream.units +
                      "/s is not between one step per second and the device's " +
                      std::to_string(tick_hz) + " steps/s");
   }
   home.rate = static_cast<std::uint32_t>(rate_steps);
   const std::int32_t backoff_steps = ToSteps(backoff, s.step);
   if (backoff < 0 || backoff_steps > config.travel_steps[0]) {
-    throw InputError("--backoff: " + FormatNumber(backoff) + " " + s.stream.units +
+    throw InputError(backoff_from + ": " + FormatNumber(backoff) + " " + s.stream.units +
                      " is not within the travel");
   }
   home.backoff = static_cast<std::uint32_t>(backoff_steps);
@@ -328,7 +388,7 @@ int Execute(const std::string& action, const ManualOptions& o, const Settings& s
   const protocol::HelloReply hello = connection->Hello();
   protocol::Command config;
   config.type = protocol::MessageType::kConfig;
-  config.body.config = ConfigOf(s, hello.tick_hz, o.require_homing);
+  config.body.config = ConfigOf(s, hello.tick_hz);
   std::vector<protocol::Command> commands = {config};
   if (action == "home") {
     if ((hello.features & protocol::kFeatureEndstops) == 0) {
@@ -376,7 +436,8 @@ void AddManualCommands(CLI::App* machine, ManualOptions* options, std::string* a
                       "the device refuses motion until homed (CONFIG flag)");
     if (std::string(name) == "home") {
       command->add_option("--axes", options->axes, "axes to home, e.g. xy (default all)");
-      command->add_option("--toward", options->toward, "min (default) or max");
+      command->add_option("--toward", options->toward,
+                          "min (default) or max, or one per axis: min,max[,min]");
       command->add_option("--rate", options->rate, "search speed, --units/s (default 5 mm/s)");
       command->add_option("--backoff", options->backoff,
                           "back-off from the switch, --units (default 1 mm)");

@@ -30,8 +30,11 @@ struct ManualOptions {
   /// stream's --step, --travel, --speed, --accel, --tick-hz as typed ("" when
   /// not given; they override the profile).
   std::string step, travel, speed, accel, tick_hz;
-  /// home: --axes (letters of x, y, z), --toward (min|max), --rate
-  /// (units/s), --backoff (units), --require-homing.
+  /// home: --axes (letters of x, y, z), --toward (min|max, or one per
+  /// axis min,max[,min]), --rate (units/s), --backoff (units); empty or
+  /// nullopt when not given: the profile's [homing] table, else the
+  /// defaults (all axes, min, 5 mm/s, 1 mm). --require-homing (every
+  /// command): on when given or when the profile's homing.required is true.
   std::string axes;
   std::string toward;
   std::optional<double> rate;

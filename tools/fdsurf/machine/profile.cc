@@ -25,8 +25,7 @@ struct PlannedKey {
   const char* why;
 };
 constexpr PlannedKey kPlannedKeys[] = {
-    {"homing", "homing is not supported yet"},
-    {"home", "homing is not supported yet"},
+    {"home", "the key is 'homing', a table: [homing] axes, toward, rate, backoff, required"},
     {"steps_per_mm", "steps per unit are not supported yet: give 'step', the length of one step"},
     {"steps_per_in", "steps per unit are not supported yet: give 'step', the length of one step"},
     {"accel_x", "acceleration per axis is not supported yet: give 'accel', the path's"},
@@ -52,6 +51,10 @@ std::string TypeName(KeyType type) {
       return "an integer";
     case KeyType::kLengthList:
       return "an array of 2 or 3 numbers [W, H] or [W, H, D]";
+    case KeyType::kBool:
+      return "true or false";
+    case KeyType::kTextList:
+      return "a string or an array of 1 to 3 strings";
     default:
       return "a number";
   }
@@ -70,6 +73,42 @@ bool NumberOf(const toml::node& node, double* out) {
     return true;
   }
   return false;
+}
+
+// A string, or an array of 1 to 3 strings, as "a,b,c"; "" when `node` is
+// neither.
+std::string TextListOf(const toml::node& node) {
+  if (const auto text = node.value<std::string>(); text && node.is_string()) return *text;
+  const toml::array* list = node.as_array();
+  if (list == nullptr || list->empty() || list->size() > 3) return "";
+  std::string joined;
+  for (const toml::node& item : *list) {
+    if (!item.is_string()) return "";
+    joined += (joined.empty() ? "" : ",") + *item.value<std::string>();
+  }
+  return joined;
+}
+
+// Why `text` fails `check` (KeyCheck::kMinOrMax, kAxisLetters), "" when it
+// passes or the check is not about text.
+std::string RefusedText(KeyCheck check, const std::string& text) {
+  if (check == KeyCheck::kMinOrMax) {
+    std::stringstream items(text);
+    for (std::string item; std::getline(items, item, ',');) {
+      if (item != "min" && item != "max") return R"(must be "min" or "max", not ")" + item + "\"";
+    }
+  }
+  if (check == KeyCheck::kAxisLetters) {
+    const bool letters = !text.empty() && text.find_first_not_of("xyz") == std::string::npos;
+    bool distinct = true;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      distinct = distinct && text.find(text[i], i + 1) == std::string::npos;
+    }
+    if (!letters || !distinct) {
+      return R"(must name the axes as distinct letters of "xyz" (like "xy"), not ")" + text + "\"";
+    }
+  }
+  return "";
 }
 
 // The value of `key` as the schema says it must be; throws KeyError.
@@ -92,6 +131,14 @@ ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std:
       if (!node.is_integer()) throw wrong_type();
       value.text = std::to_string(*node.value<std::int64_t>());
       break;
+    case KeyType::kBool:
+      if (!node.is_boolean()) throw wrong_type();
+      value.text = *node.value<bool>() ? "true" : "false";
+      break;
+    case KeyType::kTextList:
+      value.text = TextListOf(node);
+      if (value.text.empty()) throw wrong_type();
+      break;
     case KeyType::kNumber:
     case KeyType::kLength:
       if (!NumberOf(node, &number)) throw wrong_type();
@@ -108,30 +155,76 @@ ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std:
     }
   }
   for (const double n : value.numbers) {
-    const bool positive = key.check != KeyCheck::kNone || key.type == KeyType::kLengthList;
+    const bool positive = key.check == KeyCheck::kPositive || key.check == KeyCheck::kQuantum ||
+                          key.type == KeyType::kLengthList;
     if (!std::isfinite(n) || (positive && !(n > 0))) {
       throw KeyError(path, node.source(), key.name, "must be above 0, not " + FormatNumber(n));
     }
+    if (key.check == KeyCheck::kNotNegative && n < 0) {
+      throw KeyError(path, node.source(), key.name, "must be 0 or more, not " + FormatNumber(n));
+    }
   }
+  const std::string refused = RefusedText(key.check, value.text);
+  if (!refused.empty()) throw KeyError(path, node.source(), key.name, refused);
   return value;
 }
 
-const MachineKey* KeyNamed(std::string_view name) {
+// The schema's key `name` inside `table` ("" for the top level): "rate" in
+// "homing" is "homing.rate"; a top-level name never matches a table's key.
+const MachineKey* KeyNamed(std::string_view name, std::string_view table) {
+  const std::string full =
+      table.empty() ? std::string(name) : std::string(table) + "." + std::string(name);
+  if (table.empty() && full.find('.') != std::string::npos) return nullptr;
   for (const MachineKey& key : MachineKeys()) {
-    if (name == key.name) return &key;
+    if (full == key.name) return &key;
   }
   return nullptr;
 }
 
-InputError UnknownKey(const std::string& path, const toml::key& key) {
-  for (const PlannedKey& planned : kPlannedKeys) {
-    if (key.str() == planned.name) {
-      return KeyError(path, key.source(), std::string(key.str()), planned.why);
+InputError UnknownKey(const std::string& path, const toml::key& key, std::string_view table) {
+  if (table.empty()) {
+    for (const PlannedKey& planned : kPlannedKeys) {
+      if (key.str() == planned.name) {
+        return KeyError(path, key.source(), std::string(key.str()), planned.why);
+      }
     }
   }
-  return KeyError(path, key.source(), std::string(key.str()),
-                  "not a machine setting (did you mean '" + NearestMachineKey(key.str()) +
+  const std::string name =
+      table.empty() ? std::string(key.str()) : std::string(table) + "." + std::string(key.str());
+  return KeyError(path, key.source(), name,
+                  "not a machine setting (did you mean '" + NearestMachineKey(key.str(), table) +
                       "'? docs/machines.md lists them)");
+}
+
+// Reads the values of `table` (`prefix` "" for the top level, else the
+// table's name) into `profile`; the top level's `[homing]` table recurses.
+void ReadTable(const toml::table& table, std::string_view prefix, const std::string& path,
+               MachineProfile* profile) {
+  for (const auto& [name, node] : table) {
+    if (prefix.empty() && name.str() == kHomingTable) {
+      const toml::table* homing = node.as_table();
+      if (homing == nullptr) {
+        throw KeyError(
+            path, node.source(), std::string(name.str()),
+            "must be a table, [homing] with axes, toward, rate, backoff, required; not " +
+                TomlTypeName(node));
+      }
+      ReadTable(*homing, kHomingTable, path, profile);
+      continue;
+    }
+    const MachineKey* key = KeyNamed(name.str(), prefix);
+    if (key == nullptr) throw UnknownKey(path, name, prefix);
+    ProfileValue value = ReadValue(*key, node, path);
+    if (key == &MachineKeys().front()) {
+      if (value.text != "mm" && value.text != "in") {
+        throw KeyError(path, node.source(), key->name,
+                       R"(must be "mm" or "in", not ")" + value.text + "\"");
+      }
+      profile->units = value.text;
+      continue;
+    }
+    profile->values.push_back(std::move(value));
+  }
 }
 
 // A number as an option takes it: up to 15 significant digits, so that
@@ -198,16 +291,29 @@ const std::vector<MachineKey>& MachineKeys() {
        "plot G-code, pen servo: angle with the pen down"},
       {"servo_index", T::kInteger, "", "--servo-index", C::kNone,
        "plot G-code, pen servo: M280's servo index P"},
+      {"homing.axes", T::kText, "", "--axes", C::kAxisLetters,
+       "machine home: the axes homed, letters of xyz (default all)"},
+      {"homing.toward", T::kTextList, "", "--toward", C::kMinOrMax,
+       R"(machine home: "min" or "max", or one per axis ["min", "max"] (default min))"},
+      {"homing.rate", T::kLength, "units/s", "--rate", C::kPositive,
+       "machine home: the switch search speed (default 5 mm/s)"},
+      {"homing.backoff", T::kLength, "units", "--backoff", C::kNotNegative,
+       "machine home: back-off from the switch (default 1 mm)"},
+      {"homing.required", T::kBool, "", "--require-homing", C::kNone,
+       "stream, machine: the device refuses motion until homed (CONFIG flag)"},
   };
   return keys;
 }
 
-std::string NearestMachineKey(std::string_view key) {
+std::string NearestMachineKey(std::string_view key, std::string_view table) {
   std::string best;
   std::size_t best_distance = std::string::npos;
+  const std::string prefix = table.empty() ? "" : std::string(table) + ".";
   for (const MachineKey& known : MachineKeys()) {
+    std::string_view name = known.name;
+    if (name.substr(0, prefix.size()) != prefix) continue;
+    name.remove_prefix(prefix.size());
     // Levenshtein distance, one row at a time.
-    const std::string_view name = known.name;
     std::vector<std::size_t> row(name.size() + 1);
     for (std::size_t j = 0; j <= name.size(); ++j) row[j] = j;
     for (std::size_t i = 1; i <= key.size(); ++i) {
@@ -222,7 +328,7 @@ std::string NearestMachineKey(std::string_view key) {
     }
     if (row.back() < best_distance) {
       best_distance = row.back();
-      best = known.name;
+      best = std::string(name);
     }
   }
   return best;
@@ -278,20 +384,7 @@ MachineProfile ParseMachineProfile(std::string_view text, const std::string& pat
   }
   MachineProfile profile;
   profile.path = path;
-  for (const auto& [name, node] : table) {
-    const MachineKey* key = KeyNamed(name.str());
-    if (key == nullptr) throw UnknownKey(path, name);
-    ProfileValue value = ReadValue(*key, node, path);
-    if (key == &MachineKeys().front()) {
-      if (value.text != "mm" && value.text != "in") {
-        throw KeyError(path, node.source(), key->name,
-                       R"(must be "mm" or "in", not ")" + value.text + "\"");
-      }
-      profile.units = value.text;
-      continue;
-    }
-    profile.values.push_back(std::move(value));
-  }
+  ReadTable(table, "", path, &profile);
   // toml++ keeps a table's keys sorted; the file's order reads better.
   std::sort(profile.values.begin(), profile.values.end(),
             [](const ProfileValue& a, const ProfileValue& b) { return a.line < b.line; });
@@ -309,7 +402,7 @@ MachineProfile LoadMachineProfile(const std::string& path) {
 std::string OptionText(const MachineProfile& profile, const ProfileValue& value,
                        const std::string& command_units) {
   const MachineKey& key = *value.key;
-  if (key.type == KeyType::kText || key.type == KeyType::kInteger) return value.text;
+  if (!value.text.empty()) return value.text;  // kText, kInteger, kBool, kTextList
   double scale = 1;
   if (IsLength(key) && profile.units != command_units)
     scale = profile.units == "in" ? 25.4 : 1 / 25.4;

@@ -28,10 +28,23 @@ enum class KeyType {
   kNumber,      // a number, not converted between units
   kLength,      // a number in the profile's units, converted to the command's
   kLengthList,  // an array of 2 or 3 positive lengths (WxH[xD])
+  kBool,        // true or false (a command-line flag)
+  kTextList,    // a string, or an array of 1 to 3 strings (one per axis), "A,B,C" as an option
 };
 
 /// A further check beyond the type and the option's own (CLI11) check.
-enum class KeyCheck { kNone, kPositive, kQuantum };
+enum class KeyCheck {
+  kNone,
+  kPositive,
+  kQuantum,
+  kNotNegative,  // a number, 0 or more
+  kMinOrMax,     // each string "min" or "max"
+  kAxisLetters,  // a string of distinct letters of "xyz", at least one
+};
+
+/// The TOML table of the homing keys: their schema names are "homing.KEY",
+/// written `KEY = ...` under `[homing]` in the file.
+inline constexpr std::string_view kHomingTable = "homing";
 
 /// One key of a profile.
 struct MachineKey {
@@ -47,13 +60,14 @@ struct MachineKey {
 const std::vector<MachineKey>& MachineKeys();
 
 /// The known key nearest to `key` by edit distance (Levenshtein), for
-/// "did you mean ...?".
-std::string NearestMachineKey(std::string_view key);
+/// "did you mean ...?". With a `table` ("homing"), only that table's keys
+/// are candidates, and the answer is the name inside the table ("rate").
+std::string NearestMachineKey(std::string_view key, std::string_view table = {});
 
 /// One value of a profile, where it stands in its file (1-based).
 struct ProfileValue {
   const MachineKey* key = nullptr;
-  std::string text;             // kText and kInteger, as written
+  std::string text;             // kText, kInteger, kBool ("true"/"false"), kTextList ("a,b")
   std::vector<double> numbers;  // kNumber, kLength (one), kLengthList
   int line = 0;
   int column = 0;
@@ -79,7 +93,9 @@ std::string FindMachineProfile(const std::string& name_or_file);
 /// Parses `text` (the TOML of `path`). Throws InputError
 /// "PATH:LINE:COLUMN: ..." for a TOML syntax error, a key not in the schema
 /// (with the nearest known key, or "not supported yet"), a value of the
-/// wrong type or out of range.
+/// wrong type or out of range. The `[homing]` table's keys are checked
+/// against the "homing.*" keys, and a key unknown there is suggested the
+/// nearest of them.
 MachineProfile ParseMachineProfile(std::string_view text, const std::string& path);
 
 /// Reads and parses the file at `path` (InputError when it cannot be read).

@@ -7,6 +7,7 @@
 
 #include "../cli_options.h"
 #include "fdsurf/device/device.h"
+#include "fdsurf/hal/gpiod_inputs.h"
 #include "fdsurf/hal/gpiod_outputs.h"
 #include "fdsurf/hal/monotonic_clock.h"
 #include "fdsurf/hal/pwm.h"
@@ -65,10 +66,14 @@ struct GpioRig {
         pen(pen_output),
         progress(ShowProgress(quiet)) {}
 
-  // The failed output's detail: the lines', else the pen's.
+  // The failed output's detail: the lines', else the pen's, else the
+  // endstops' (a switch that could not be read).
   FDSURF_NODISCARD std::string OutputError() const {
     const std::string lines_error = outputs.StepDirOutputs::LastError();
-    return "gpio: " + (lines_error.empty() ? std::string(pen.LastError()) : lines_error);
+    if (!lines_error.empty()) return "gpio: " + lines_error;
+    const std::string pen_error = pen.LastError();
+    if (pen_error.empty() && endstops != nullptr) return endstops->LastError();
+    return "gpio: " + pen_error;
   }
 
   hal::MonotonicClock clock;
@@ -76,8 +81,23 @@ struct GpioRig {
   HostLink link;
   hal::GpiodOutputs& outputs;
   hal::PenOutput& pen;
+  hal::EndstopInputs* endstops = nullptr;  // the ENDSTOPS of --device, if any
   ProgressLine progress;
 };
+
+// The ENDSTOPS part of --device (hal/gpiod_inputs.h) checked, before any
+// line is opened; no switch when it is left out.
+hal::GpioEndstopConfig EndstopsOf(const hal::GpiodConfig& config) {
+  hal::GpioEndstopConfig endstops;
+  endstops.chip = config.chip;
+  endstops.consumer = config.consumer;
+  std::string error;
+  if (!config.endstops.empty() &&
+      !hal::ParseGpioEndstops(config.endstops, config, &endstops, &error)) {
+    throw InputError("--device: " + error);
+  }
+  return endstops;
+}
 
 // Ticks `device` while `keep_going()`; DeviceError when an output fails.
 template <class Device, class KeepGoing>
@@ -193,10 +213,16 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
     throw InputError("--device: " + std::to_string(config.axes) +
                      " axes of lines given for --dims " + std::to_string(o.dims));
   }
+  const hal::GpioEndstopConfig endstop_config = EndstopsOf(config);
   const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
   CheckSpeedAgainstTicks(job, tick_hz, o);
   std::unique_ptr<hal::GpiodOutputs> outputs;
   if (hal::GpiodOutputs::Open(config, &outputs, &error) != hal::IoStatus::kOk) {
+    throw DeviceError(error);
+  }
+  std::unique_ptr<hal::GpiodEndstops> endstops;
+  if (!config.endstops.empty() &&
+      hal::GpiodEndstops::Open(endstop_config, &endstops, &error) != hal::IoStatus::kOk) {
     throw DeviceError(error);
   }
   std::unique_ptr<PwmServoPen> servo;
@@ -204,12 +230,15 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   const InterruptGuard interrupts;
   GpioRig rig(*outputs, servo ? servo->pen() : *outputs, tick_hz, o.quiet);
   rig.progress.SetSchedule(o.schedule.get());
+  rig.endstops = endstops.get();
   int code = 0;
   if (o.dims == 3) {
     auto device = std::make_unique<device::Device<3>>(tick_hz);
+    device->set_endstops(rig.endstops);
     code = RunLayers(o, job, rig, *device, tick_hz);
   } else {
     auto device = std::make_unique<device::Device<2>>(tick_hz);
+    device->set_endstops(rig.endstops);
     code = RunLayers(o, job, rig, *device, tick_hz);
   }
   if (code != 0 || o.quiet) return code;

@@ -64,6 +64,10 @@ struct GpiodConfig {
   bool has_pen_line = true;
   unsigned pen_pwm_chip = 0;
   unsigned pen_pwm_channel = 0;
+  /// The ENDSTOPS part of `gpio:CHIP:LINES:ENDSTOPS` as written ("" when
+  /// left out), for ParseGpioEndstops (gpiod_inputs.h); no line of it is
+  /// requested here.
+  std::string endstops;
   /// The shortest STEP pulse, in microseconds, busy-waited on CLOCK_MONOTONIC:
   /// both the high time and the low time before the next pulse. A4988 needs
   /// 1 µs, DRV8825 1.9 µs.
@@ -78,7 +82,8 @@ struct GpiodConfig {
   std::string dev_dir = "/dev";
 };
 
-/// Parses "gpio:CHIP:LINES" (see the top of this file) into `config`, keeping
+/// Parses "gpio:CHIP:LINES[:ENDSTOPS]" (see the top of this file; ENDSTOPS,
+/// a part holding '=', is kept as text in config->endstops) into `config`, keeping
 /// its other fields. Returns false with a one-line reason in `*error`
 /// (e.g. "gpio:gpiochip0:17,27,22: 3 lines given; expected ...").
 bool ParseGpioDevice(std::string_view spec, GpiodConfig* config, std::string* error);

@@ -41,6 +41,9 @@ struct MachineOptions {
   /// in 500..2500.
   int servo_up_us = 0;
   int servo_down_us = 0;
+  /// CONFIG's kConfigFlagHomingRequired: the device refuses motion
+  /// (kNotHomed) until every axis has been homed (`fdsurf machine home`).
+  bool homing_required = false;
 };
 
 /// One patch as the device will draw it, for checks: the patch, and the
