@@ -181,6 +181,35 @@ void AddJournalOptions(CLI::App* command, StreamOptions* o) {
 
 MachineOptions StreamMachine(const StreamOptions& o) { return Machine(o); }
 
+// The options that only the simulated plotter (--device sim) uses: its link,
+// its fault injection, its cost model and what it writes.
+void AddSimulatorOptions(CLI::App* command, StreamOptions* o) {
+  command
+      ->add_option("--link-rate", o->link_bytes_per_second,
+                   "sim: bytes per second each way on the link (1000000 ~ USB full speed)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--faults", o->faults,
+                   "sim: drop, corrupt, duplicate, reorder and truncate each frame with this "
+                   "probability (0..0.5)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  command->add_option("--seed", o->seed, "sim: seed of the fault injection")->capture_default_str();
+  command
+      ->add_option("--sim-cost", o->sim_cost,
+                   "sim: charge the device's validation time as on this MCU (none, atmega2560)")
+      ->check(CLI::IsMember({"none", "atmega2560"}))
+      ->capture_default_str();
+  command->add_option("--svg", o->svg, "sim: write what the plotter drew as SVG");
+  command->add_option("--png", o->png, "sim: draw what the plotter drew as a PNG picture");
+  command->add_option("--waveform", o->waveform,
+                      "sim: write the plotter's step/dir/enable/pen pins (docs/boards.md)");
+  command->add_option("--size", o->png_width, "PNG width in pixels")
+      ->check(CLI::Range(16, 20000))
+      ->capture_default_str();
+}
+
 void AddStreamOptions(CLI::App* command, StreamOptions* o) {
   AddInputOptions(command, &o->file, &o->input_format, &o->reader);
   command
@@ -225,17 +254,6 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                       "the device's step timer (sim: 40000 by default, must divide 1000000; "
                       "gpio: 10000)");
   command
-      ->add_option("--link-rate", o->link_bytes_per_second,
-                   "sim: bytes per second each way on the link (1000000 ~ USB full speed)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command
-      ->add_option("--faults", o->faults,
-                   "sim: drop, corrupt, duplicate, reorder and truncate each frame with this "
-                   "probability (0..0.5)")
-      ->check(CLI::Range(0.0, 0.5))
-      ->capture_default_str();
-  command
       ->add_option("--connect-timeout", o->connect_timeout_s,
                    "usb, serial: seconds to retry HELLO before giving up (a board reset by "
                    "opening its port is silent 1-2 s)")
@@ -246,19 +264,7 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                    "usb, serial: seconds a device that hung up may take to come back")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
-  command->add_option("--seed", o->seed, "sim: seed of the fault injection")->capture_default_str();
-  command
-      ->add_option("--sim-cost", o->sim_cost,
-                   "sim: charge the device's validation time as on this MCU (none, atmega2560)")
-      ->check(CLI::IsMember({"none", "atmega2560"}))
-      ->capture_default_str();
-  command->add_option("--svg", o->svg, "sim: write what the plotter drew as SVG");
-  command->add_option("--png", o->png, "sim: draw what the plotter drew as a PNG picture");
-  command->add_option("--waveform", o->waveform,
-                      "sim: write the plotter's step/dir/enable/pen pins (docs/boards.md)");
-  command->add_option("--size", o->png_width, "PNG width in pixels")
-      ->check(CLI::Range(16, 20000))
-      ->capture_default_str();
+  AddSimulatorOptions(command, o);
   command
       ->add_option("--hidden", o->hidden,
                    "show (every line) or remove (only the visible pieces, streamed as curves)")
