@@ -106,9 +106,17 @@ Command JobCommand(uint32_t i, bool small_only = false) {
   c.seq = 0;
   if (i == 0) {
     c.type = MessageType::kConfig;
-    c.body.config = MachineConfig{
-        2,    {80000, 80000, 0}, {kMaxTravelSteps, kMaxTravelSteps, 0}, 4000, 20000, 0,
-        4000, {20000, 20000, 0}, 0, 0, 0};
+    c.body.config = MachineConfig{2,
+                                  {80000, 80000, 0},
+                                  {kMaxTravelSteps, kMaxTravelSteps, 0},
+                                  4000,
+                                  20000,
+                                  0,
+                                  4000,
+                                  {20000, 20000, 0},
+                                  0,
+                                  0,
+                                  0};
     return c;
   }
   const uint32_t kind = small_only ? i % 2 : i % 7;
@@ -1001,7 +1009,8 @@ Command Config(uint32_t max_rate) {
   c.type = MessageType::kConfig;
   c.seq = 0;
   c.body.config = MachineConfig{2, {80000, 80000, 0}, {100000, 100000, 0}, max_rate, 20000,
-                                0, max_rate,          {20000, 20000, 0}, 0, 0, 0};
+                                0, max_rate,          {20000, 20000, 0},   0,        0,
+                                0};
   return c;
 }
 Command Move(int32_t x, int32_t y) {

@@ -75,7 +75,7 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
  public:
   RecordingOutputs() : StepDirOutputs(2) {}
   uint64_t steps[3] = {0, 0, 0};
-  int64_t position[3] = {0, 0, 0};  // signed, for the endstops
+  int64_t position[3] = {0, 0, 0};            // signed, for the endstops
   uint64_t digest = 14695981039346656037ull;  // FNV-1a 64-bit offset basis
   /// The same over the steps only (a pause adds a pen lift and lowering).
   uint64_t step_digest = 14695981039346656037ull;

@@ -384,9 +384,7 @@ void ReadMotors(Reader* r, MotorsCommand* m) {
 
 bool ErrorCodeValid(uint8_t code) { return code <= kLastErrorCode; }
 
-bool DeviceStateValid(uint8_t state) {
-  return state <= static_cast<uint8_t>(DeviceState::kHoming);
-}
+bool DeviceStateValid(uint8_t state) { return state <= static_cast<uint8_t>(DeviceState::kHoming); }
 
 }  // namespace
 

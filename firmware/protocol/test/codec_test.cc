@@ -55,8 +55,8 @@ Command Config() {
   Command c;
   c.type = MessageType::kConfig;
   c.seq = 0;
-  c.body.config = MachineConfig{2,    {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150,
-                                6000, {30000, 25000, 0}, 0,     0,     0};
+  c.body.config = MachineConfig{
+      2, {80000, 80000, 0}, {16000, 12000, 0}, 4000, 20000, 150, 6000, {30000, 25000, 0}, 0, 0, 0};
   return c;
 }
 
