@@ -83,7 +83,7 @@ protocol::Command Config(std::int32_t travel) {
   c.accel = 160000;
   c.pen_delay_ms = 2;
   c.travel_rate = 8000;
-  c.axis_accel[0] = c.axis_accel[1] = 160000;
+  c.axis_accel[0] = c.axis_accel[1] = 320000;
   c.axis_accel[2] = 0;
   return command;
 }

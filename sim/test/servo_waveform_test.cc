@@ -32,7 +32,7 @@ protocol::Command Config(std::uint16_t up_us, std::uint16_t down_us) {
   c.seq = 0;
   c.body.config =
       protocol::MachineConfig{2,    {80000, 80000, 0}, {4000, 4000, 0}, 4000,    20000, kPenDelayMs,
-                              4000, {20000, 20000, 0}, up_us,           down_us, 0};
+                              4000, {40000, 40000, 0}, up_us,           down_us, 0};
   return c;
 }
 

@@ -294,7 +294,7 @@ protocol::MachineConfig Config(std::int32_t travel) {
   config.accel = 160000;
   config.pen_delay_ms = 10;
   config.travel_rate = 8000;
-  config.axis_accel[0] = config.axis_accel[1] = 160000;
+  config.axis_accel[0] = config.axis_accel[1] = 320000;
   return config;
 }
 

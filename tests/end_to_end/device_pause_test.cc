@@ -35,7 +35,7 @@ protocol::Command ConfigCommand() {
   config.accel = kAccel;
   config.pen_delay_ms = kPenDelayMs;
   config.travel_rate = config.max_rate;
-  config.axis_accel[0] = config.axis_accel[1] = config.accel;
+  config.axis_accel[0] = config.axis_accel[1] = 2 * config.accel;
   return command;
 }
 

@@ -33,7 +33,7 @@ protocol::Command ConfigCommand(std::uint8_t flags = 0) {
   config.accel = 160000;
   config.pen_delay_ms = 10;
   config.travel_rate = config.max_rate;
-  config.axis_accel[0] = config.axis_accel[1] = config.accel;
+  config.axis_accel[0] = config.axis_accel[1] = 2 * config.accel;
   config.flags = flags;
   return command;
 }

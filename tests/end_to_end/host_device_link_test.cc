@@ -113,7 +113,7 @@ Command JobCommand(uint32_t i, bool small_only = false) {
                                   20000,
                                   0,
                                   4000,
-                                  {20000, 20000, 0},
+                                  {40000, 40000, 0},
                                   0,
                                   0,
                                   0};
@@ -1009,7 +1009,7 @@ Command Config(uint32_t max_rate) {
   c.type = MessageType::kConfig;
   c.seq = 0;
   c.body.config = MachineConfig{2, {80000, 80000, 0}, {100000, 100000, 0}, max_rate, 20000,
-                                0, max_rate,          {20000, 20000, 0},   0,        0,
+                                0, max_rate,          {40000, 40000, 0},   0,        0,
                                 0};
   return c;
 }

@@ -120,7 +120,7 @@ protocol::Command ConfigCommand() {
   config.accel = kAccel;
   config.pen_delay_ms = 10;
   config.travel_rate = kTravelRate;
-  config.axis_accel[0] = config.axis_accel[1] = kAccel;
+  config.axis_accel[0] = config.axis_accel[1] = 2 * kAccel;
   return command;
 }
 
@@ -131,13 +131,19 @@ TEST(TravelSpeed, DeviceRefusesTravelRateAndAxisAccelItCannotServe) {
   config.body.config.travel_rate = kTickHz + 1;
   EXPECT_EQ(device.Accept(config, &detail), protocol::ErrorCode::kBadField);
   EXPECT_EQ(detail, protocol::kConfigFieldTravelRate);
-  // 95 steps/s² at 40 kHz is 95·2^24/1.6e9 ≈ 0.996 units per tick²: rounds to 0.
+  // An axis limit must exceed the path's per tick (the excess is the turn
+  // budget). At 40 kHz the path's 160000 steps/s² is ⌊160000·2^24/1.6e9⌋ =
+  // 1677 units per tick²; so is an axis's 160026, while 160027 gives 1678.
   config = ConfigCommand();
-  config.body.config.axis_accel[1] = 95;
+  config.body.config.axis_accel[1] = kAccel;
   EXPECT_EQ(device.Accept(config, &detail), protocol::ErrorCode::kBadField);
   EXPECT_EQ(detail, protocol::kConfigFieldAxisAccel + 1);
   config = ConfigCommand();
-  config.body.config.axis_accel[0] = 96;  // ≈ 1.007 units per tick²: representable
+  config.body.config.axis_accel[0] = 160026;
+  EXPECT_EQ(device.Accept(config, &detail), protocol::ErrorCode::kBadField);
+  EXPECT_EQ(detail, protocol::kConfigFieldAxisAccel);
+  config = ConfigCommand();
+  config.body.config.axis_accel[0] = 160027;
   EXPECT_EQ(device.Accept(config, &detail), protocol::ErrorCode::kNone);
   EXPECT_EQ(device.Credits(), 3);  // only the last was queued
 }

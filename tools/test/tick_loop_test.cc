@@ -78,7 +78,7 @@ protocol::Command Config() {
   config.accel = kAccel;
   config.pen_delay_ms = 0;
   config.travel_rate = kMaxRate;
-  config.axis_accel[0] = config.axis_accel[1] = kAccel;
+  config.axis_accel[0] = config.axis_accel[1] = 2 * kAccel;
   return command;
 }
 

@@ -3,6 +3,24 @@
 
 namespace fdsurf {
 namespace motion {
+namespace {
+
+// ⌊√n⌋ by bisection on the root (n < 2^64; 32 rounds, at configuration).
+uint64_t FloorSqrt(uint64_t n) {
+  uint64_t low = 0;
+  uint64_t high = 1ull << 32;  // high² > n
+  while (high - low > 1) {
+    const uint64_t middle = low + (high - low) / 2;
+    if (middle * middle <= n) {
+      low = middle;
+    } else {
+      high = middle;
+    }
+  }
+  return low;
+}
+
+}  // namespace
 
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
   if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz ||
@@ -20,11 +38,41 @@ bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
   out->accel = static_cast<uint32_t>(accel);
   out->pen_delay_ticks =
       static_cast<uint32_t>(static_cast<uint64_t>(limits.pen_delay_ms) * hz / 1000);
+  // The smallest axis limit per tick, capped at one step per tick² (a lower
+  // limit is conservative), so that the products in TurnCaps fit in 64 bits.
+  uint64_t smallest = 0;
+  for (const uint32_t axis_accel : limits.axis_accel) {
+    if (axis_accel == 0) continue;
+    if (!AxisLimitServable(axis_accel, limits.accel, limits.tick_hz)) return false;
+    uint64_t per_tick = (static_cast<uint64_t>(axis_accel) << kLengthFracBits) / (hz * hz);
+    if (per_tick > (uint64_t{1} << kLengthFracBits)) per_tick = uint64_t{1} << kLengthFracBits;
+    if (smallest == 0 || per_tick < smallest) smallest = per_tick;
+  }
+  out->turn_budget =
+      smallest == 0 ? 0 : static_cast<uint32_t>(FloorSqrt(smallest * smallest - accel * accel));
+  const uint32_t top = out->max_speed > out->travel_speed ? out->max_speed : out->travel_speed;
+  TurnCaps::SkipThresholds(out->turn_budget, top, out->turn_skip);
   return true;
+}
+
+bool AxisLimitServable(uint32_t axis_accel, uint32_t accel, uint32_t tick_hz) {
+  if (tick_hz == 0) return false;
+  const uint64_t hz = tick_hz;
+  const uint64_t axis_per_tick = (static_cast<uint64_t>(axis_accel) << kLengthFracBits) / (hz * hz);
+  const uint64_t path_per_tick = (static_cast<uint64_t>(accel) << kLengthFracBits) / (hz * hz);
+  return axis_per_tick > path_per_tick;
 }
 
 MotionLoop::MotionLoop(uint8_t* storage, uint16_t capacity)
     : storage_(storage), capacity_(capacity), mask_(static_cast<uint16_t>(capacity - 1)) {}
+
+void MotionLoop::Configure(const TickLimits& limits) {
+  limits_ = limits;
+  const uint32_t top =
+      limits.max_speed > limits.travel_speed ? limits.max_speed : limits.travel_speed;
+  caps_.Configure(limits.turn_budget, limits.accel, top, limits.turn_skip);
+  head_start_ = 0;
+}
 
 uint32_t MotionLoop::LengthOf(uint8_t move) {
   int axes = 0;
@@ -32,8 +80,19 @@ uint32_t MotionLoop::LengthOf(uint8_t move) {
   return kMoveLength[axes];
 }
 
-bool MotionLoop::Push(uint8_t entry) {
+MotionLoop::PreparedEntry MotionLoop::Prepare(uint8_t entry) {
+  const EntryKind kind = KindOf(entry);
+  if (kind == EntryKind::kMove) return PreparedEntry{entry, caps_.Measure(entry, LengthOf(entry))};
+  // The loop rests at a pen event: no chord spans it.
+  if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) {
+    return PreparedEntry{entry, caps_.MeasureAll(false)};
+  }
+  return PreparedEntry{entry, TurnCaps::Final{0, 0, false, false}};
+}
+
+bool MotionLoop::Push(const PreparedEntry& prepared) {
   if (Full()) return false;
+  const uint8_t entry = prepared.entry;
   storage_[(head_ + count_) & mask_] = entry;
   ++count_;
   const EntryKind kind = KindOf(entry);
@@ -44,10 +103,12 @@ bool MotionLoop::Push(uint8_t entry) {
     uint64_t& run = stops_ == 0 ? distance_ : runs_[(first_run_ + stops_ - 1) % kMaxPenEvents];
     run += LengthOf(entry);
   }
+  caps_.Commit(prepared.final);
   return true;
 }
 
 void MotionLoop::Pop() {
+  if (KindOf(At(0)) == EntryKind::kMove) head_start_ += LengthOf(At(0));
   head_ = static_cast<uint16_t>((head_ + 1) & mask_);
   --count_;
 }
@@ -64,6 +125,8 @@ void MotionLoop::Clear() {
   pen_wait_ = 0;
   stopping_ = false;
   pausing_ = false;
+  head_start_ = 0;
+  caps_.Clear();
 }
 
 void MotionLoop::set_position(const int32_t (&position)[3]) {
@@ -126,7 +189,14 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     return out;
   }
 
-  const uint64_t available = distance_ - phase_;
+  // Where the loop must be able to stop: the next pen event or the end of
+  // the buffer, or the end of the moves whose turn caps are final; and what
+  // the caps allow (docs/motion.md, "Each axis on curves").
+  const uint64_t position = head_start_ + phase_;
+  const TurnCaps::Bounds caps = caps_.At(position);
+  const uint64_t caps_left = caps.limit > position ? caps.limit - position : 0;
+  const uint64_t stop_left = distance_ - phase_;
+  const uint64_t available = caps_left < stop_left ? caps_left : stop_left;
   const uint32_t a = limits_.accel;
   const uint64_t v = speed_;
   // Pen down: drawing speed; pen up: travel speed. pen_down_ changes only
@@ -134,11 +204,12 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
   // under the new limit and every bound in docs/motion.md holds per run.
   const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
   uint64_t advance = 0;
-  if (!braking && v + a <= limit && (v + a) + braking_ + v <= available) {
+  if (!braking && v + a <= limit && (v + a) + braking_ + v <= available &&
+      braking_ + v <= caps.braking) {
     braking_ += v;  // B(n+1) = B(n) + n·a
     speed_ += a;
     advance = speed_;
-  } else if (!braking && v + braking_ <= available && v <= limit) {
+  } else if (!braking && v + braking_ <= available && v <= limit && braking_ <= caps.braking) {
     advance = v;
   } else if (v >= a) {
     speed_ -= a;

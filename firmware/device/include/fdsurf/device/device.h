@@ -136,20 +136,23 @@ class Device {
       }
       if (!RoomToFill()) return;
       if (generator_.Idle()) {
-        if (queued_ == 0) return;
+        // Nothing more to expand for now (or a command that waits for
+        // rest): the buffered moves are all the loop will get, so their
+        // turn caps become final (MotionLoop::Flush()).
+        if (queued_ == 0) return FlushMotion();
         const protocol::Command& next = queue_[queue_head_];
         if (next.type == protocol::MessageType::kConfig) {
-          if (!ApplyConfigAtRest(next.body.config)) return;
+          if (!ApplyConfigAtRest(next.body.config)) return FlushMotion();
           PopCommand();
           continue;
         }
         if (next.type == protocol::MessageType::kHome) {
           // Tick() does the homing; nothing is expanded until it ends.
           if (StartHomingAtRest(next.body.home)) PopCommand();
-          return;
+          return FlushMotion();
         }
         if (next.type == protocol::MessageType::kMotors) {
-          if (!RequestMotorsAtRest(next.body.motors.enabled)) return;
+          if (!RequestMotorsAtRest(next.body.motors.enabled)) return FlushMotion();
           PopCommand();
           continue;
         }
@@ -163,9 +166,11 @@ class Device {
         }
         continue;
       }
-      // RoomToFill() saw room, and Tick() only ever makes more.
+      // RoomToFill() saw room, and Tick() only ever makes more. The turn
+      // caps' measuring runs with the tick enabled; only the push is masked.
+      const motion::MotionLoop::PreparedEntry prepared = motion_.Prepare(entry);
       const InterruptLock lock;
-      (void)motion_.Push(entry);
+      (void)motion_.Push(prepared);
       ++pushed;
     }
   }
@@ -249,13 +254,15 @@ class Device {
         return protocol::ErrorCode::kDimsMismatch;
       }
       motion::TickLimits limits;
-      if (!motion::ToTickLimits(LimitsOf(config), &limits)) {
+      motion::MotionLimits path_limits = LimitsOf(config);
+      for (uint32_t& axis_accel : path_limits.axis_accel) axis_accel = 0;
+      if (!motion::ToTickLimits(path_limits, &limits)) {
         *detail = config.max_rate > tick_hz_      ? protocol::kConfigFieldMaxRate
                   : config.travel_rate > tick_hz_ ? protocol::kConfigFieldTravelRate
                                                   : protocol::kConfigFieldAccel;
         return protocol::ErrorCode::kBadField;
       }
-      if (!AxisAccelRepresentable(config, detail)) return protocol::ErrorCode::kBadField;
+      if (!AxisAccelServable(config, detail)) return protocol::ErrorCode::kBadField;
       // A travel over kMaxPlannableTravelSteps would allow moves the engine
       // cannot plan: refused here, so that no accepted move can fault.
       uint8_t axis = 0;
@@ -391,21 +398,22 @@ class Device {
 
  private:
   FDSURF_NODISCARD motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
-    return motion::MotionLimits{tick_hz_, config.max_rate, config.accel, config.pen_delay_ms,
-                                config.travel_rate};
+    motion::MotionLimits limits{tick_hz_,           config.max_rate,
+                                config.accel,       config.pen_delay_ms,
+                                config.travel_rate, {0, 0, 0}};
+    for (int a = 0; a < config.axes && a < protocol::kMaxAxes && a < 3; ++a) {
+      limits.axis_accel[a] = config.axis_accel[a];
+    }
+    return limits;
   }
 
-  // Each used axis's acceleration limit must be at least 2^-24 steps per
-  // tick², as ToTickLimits() requires of the path's: a smaller one rounds
-  // to zero at this tick rate. (The loop does not act on it yet; refusing
-  // now keeps a configuration that a later device would refuse from being
-  // accepted today.) false: *detail names the field (11..13).
-  bool AxisAccelRepresentable(const protocol::MachineConfig& config, uint8_t* detail) const {
-    const uint64_t hz = tick_hz_;
+  // Each used axis's acceleration limit must exceed the path's at this tick
+  // rate, per tick and rounded down as the loop uses them: the difference is
+  // what the turn caps leave for the centripetal part (docs/motion.md, "Each
+  // axis on curves"). false: *detail names the field (11..13).
+  bool AxisAccelServable(const protocol::MachineConfig& config, uint8_t* detail) const {
     for (int a = 0; a < config.axes && a < protocol::kMaxAxes; ++a) {
-      const uint64_t per_tick =
-          (static_cast<uint64_t>(config.axis_accel[a]) << motion::kLengthFracBits) / (hz * hz);
-      if (per_tick == 0) {
+      if (!motion::AxisLimitServable(config.axis_accel[a], config.accel, tick_hz_)) {
         *detail = static_cast<uint8_t>(protocol::kConfigFieldAxisAccel + a);
         return false;
       }
@@ -455,6 +463,20 @@ class Device {
     for (int a = 0; a < protocol::kMaxAxes; ++a) applied_travel_[a] = config.travel_steps[a];
     ++executed_;
     return true;
+  }
+
+  // MotionLoop::Flush() in its halves, the measuring with the tick enabled.
+  // Only Fill() changes what is pending, and Tick() only ever makes room;
+  // when Full(), the next Fill() tries again.
+  void FlushMotion() {
+    if (!motion_.FlushPending()) return;
+    {
+      const InterruptLock lock;
+      if (motion_.Full()) return;
+    }
+    const motion::TurnCaps::Final final = motion_.PrepareFlush();
+    const InterruptLock lock;
+    motion_.CommitFlush(final);
   }
 
   FDSURF_NODISCARD bool RoomToFill() const {

@@ -17,6 +17,8 @@
 // end of what is buffered): v' + B(v') ≤ distance available. If v was
 // feasible on the previous tick, v − a is feasible now, so the loop can always
 // stop in time; it never needs to know the future beyond its buffer.
+// With axis limits, speed caps on curves (TurnCaps) are points and stretches
+// of the path with a braking bound of their own, kept the same way.
 // docs/motion.md gives the proof and the units.
 //
 // Threading: Push() is called by the producer (main loop), Tick() by the step
@@ -29,6 +31,7 @@
 
 #include "fdsurf/config/nodiscard.h"
 #include "fdsurf/motion/entry.h"
+#include "fdsurf/motion/turn_caps.h"
 
 namespace fdsurf {
 namespace motion {
@@ -45,6 +48,10 @@ struct MotionLimits {
   uint16_t pen_delay_ms;
   /// Largest path speed with the pen up (travel), steps per second; ≤ tick_hz.
   uint32_t travel_rate;
+  /// Each axis's acceleration limit, steps per second², the centripetal
+  /// part on curves included; above `accel` (what is left over makes the
+  /// turn budget), or 0: the axis is not limited beyond the path's `accel`.
+  uint32_t axis_accel[3];
 };
 
 /// The same limits per tick, as the loop uses them.
@@ -57,13 +64,26 @@ struct TickLimits {
   uint32_t pen_delay_ticks;
   /// Largest speed with the pen up, 2^-24 steps per tick (≤ 2^24).
   uint32_t travel_speed;
+  /// The largest centripetal acceleration (2^-24 steps per tick²) the turn
+  /// caps allow: ⌊√(A² − a²)⌋ for the smallest axis limit A per tick (at
+  /// most 2^24) and the path's a, so that √(a² + budget²) ≤ A bounds every
+  /// axis (docs/motion.md); 0: no axis is limited.
+  uint32_t turn_budget;
+  /// TurnCaps::SkipThresholds() of the budget and the larger speed limit.
+  uint32_t turn_skip[TurnCaps::kChords];
 };
 
 /// Converts limits to per-tick units. Returns false when they cannot be
-/// served: max_rate or travel_rate of 0 or above tick_hz, or an
-/// acceleration below 2^-24 steps per tick² (too small to represent at this
-/// tick rate) or above either speed limit per tick.
+/// served: max_rate or travel_rate of 0 or above tick_hz, an acceleration
+/// below 2^-24 steps per tick² (too small to represent at this tick rate) or
+/// above either speed limit per tick, or an axis limit (not 0) that does not
+/// exceed the path's acceleration per tick (AxisLimitServable()).
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out);
+
+/// Whether an axis limit of `axis_accel` steps/s² leaves a turn budget over
+/// the path's `accel` at `tick_hz`: its value per tick, rounded down, must be
+/// above the path's.
+bool AxisLimitServable(uint32_t axis_accel, uint32_t accel, uint32_t tick_hz);
 
 /// What one tick did.
 struct TickOutput {
@@ -82,11 +102,14 @@ class MotionLoop {
   /// does not own it. Starts at rest at position 0 with the pen up.
   MotionLoop(uint8_t* storage, uint16_t capacity);
 
-  /// Sets the limits used from now on; call only when AtRest() and Empty().
+  /// Sets the limits used from now on; call only when Idle().
   /// The speed limit is limits.max_speed while the pen is down and
   /// limits.travel_speed while it is up; it changes only where the loop
   /// passes a pen event, which it always does at rest (docs/motion.md).
-  void Configure(const TickLimits& limits) { limits_ = limits; }
+  /// With turn budgets, the speed on curves is capped so that each axis
+  /// keeps its limit (TurnCaps). A few dozen stores, no division (an MCU
+  /// calls it with the step interrupt masked).
+  void Configure(const TickLimits& limits);
   FDSURF_NODISCARD const TickLimits& limits() const { return limits_; }
 
   /// The most pen events buffered at once. The loop stops at every pen
@@ -97,11 +120,49 @@ class MotionLoop {
   /// cycles with 256 entries).
   static constexpr uint8_t kMaxPenEvents = 4;
 
-  /// Appends an entry; false (and nothing changes) when Full().
-  bool Push(uint8_t entry);
+  /// Appends an entry; false (and nothing changes) when Full(). With turn
+  /// budgets, a move is measured for the caps (a few dozen additions; a
+  /// division only where the path turns enough to bind), and the loop
+  /// plans only up to TurnCaps::kPendingMoves moves before the newest until
+  /// a pen event or Flush() makes the rest final.
+  bool Push(uint8_t entry) {
+    if (Full()) return false;
+    return Push(Prepare(entry));
+  }
+
+  /// Push() in two halves, for a producer that shares the loop with an
+  /// interrupt: Prepare() does the measuring, touching nothing Tick() reads,
+  /// so it runs with the interrupt enabled; Push(prepared), a few additions,
+  /// under the lock. Prepare() only when !Full() (Tick() never makes the
+  /// loop full), and push each prepared entry before preparing the next.
+  struct PreparedEntry {
+    uint8_t entry;
+    TurnCaps::Final final;
+  };
+  PreparedEntry Prepare(uint8_t entry);
+  bool Push(const PreparedEntry& prepared);
+
+  /// The producer has nothing more for now: makes every buffered move final
+  /// and brings the path down to speed a at the end of them (the path may
+  /// go on in any direction). Returns false, doing nothing, when Full();
+  /// does nothing when no move waits. Without turn budgets there is nothing
+  /// to do. In two halves as Push(): FlushPending() says whether there is
+  /// anything to do, PrepareFlush() (only then, and when !Full()) measures,
+  /// CommitFlush() applies under the lock.
+  bool Flush() {
+    if (!FlushPending()) return true;
+    if (Full()) return false;
+    CommitFlush(PrepareFlush());
+    return true;
+  }
+  FDSURF_NODISCARD bool FlushPending() const { return caps_.HasPending(); }
+  TurnCaps::Final PrepareFlush() { return caps_.MeasureAll(true); }
+  void CommitFlush(const TurnCaps::Final& final) { caps_.Commit(final); }
   /// No room for an entry of any kind: the buffer is full, or it holds
-  /// kMaxPenEvents pen events.
-  FDSURF_NODISCARD bool Full() const { return count_ == capacity_ || stops_ == kMaxPenEvents; }
+  /// kMaxPenEvents pen events, or the caps have no room for more regions.
+  FDSURF_NODISCARD bool Full() const {
+    return count_ == capacity_ || stops_ == kMaxPenEvents || !caps_.HasRoom();
+  }
   FDSURF_NODISCARD bool Empty() const { return count_ == 0; }
   FDSURF_NODISCARD uint16_t Count() const { return count_; }
   /// At rest, not waiting for the pen, nothing buffered.
@@ -169,7 +230,11 @@ class MotionLoop {
   /// Distance needed to come to rest from speed_: a·n(n−1)/2.
   uint64_t braking_ = 0;
   uint32_t pen_wait_ = 0;
-  TickLimits limits_ = {0, 1, 0, 0};
+  TickLimits limits_ = {0, 1, 0, 0, 0, {0, 0, 0, 0}};
+  /// Path coordinate (2^-24 steps since Clear()) where the head move starts;
+  /// the loop is at head_start_ + phase_.
+  uint64_t head_start_ = 0;
+  TurnCaps caps_;
   int32_t position_[3] = {0, 0, 0};
   uint32_t moves_ = 0;
   bool pen_down_ = false;

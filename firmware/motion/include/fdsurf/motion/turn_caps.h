@@ -1,0 +1,185 @@
+// SPDX-License-Identifier: MIT
+// Speed caps from the path's turning, so that each axis's acceleration stays
+// within its limit on curves and through joins (docs/motion.md, "Each axis
+// on curves").
+//
+// The motion loop limits the path's tangential acceleration to a. An axis
+// also sees the centripetal part v²·κ (κ = x'', the second derivative of the
+// position by path length, perpendicular to the path), and
+// |a_t·t_i + v²·κ_i| ≤ √(a² + (v²·|κ|)²), so every axis keeps its limit A
+// while v²·|κ| stays within the turn budget C = √(A² − a²). TurnCaps
+// measures κ on the unit moves themselves, as second differences over
+// chords of m = 4, 8, 16 and 32 moves
+//
+//     d = (p[c+m] − p[c]) − (p[c] − p[c−m])        (whole steps per axis)
+//
+// (the shorter chords leave out the 2 steps per axis that rounding the
+// points to steps can make; the longest counts all), and turns each chord
+// that binds into a speed cap for its 2m moves. The cap is kept as a braking
+// distance (B(n) ≤ cap, which the loop compares with the braking distance it
+// already keeps), so the tick loop compares and adds only; the divisions
+// happen here, when a move is pushed, and only for chords whose turning
+// binds (a threshold computed at configuration skips the others).
+//
+// A move's cap is final once every chord that covers it has been measured,
+// 2·32 − 1 moves after it; until then the loop treats the end of the final
+// moves as a point where it must be able to stop. Final caps are kept as
+// regions (runs of moves under one cap) in a small deque ordered so that its
+// front is the one that binds now (the minimum of start + cap over what is
+// ahead; a region that another one dominates is dropped). docs/motion.md,
+// "Each axis on curves", has the derivation and the proof.
+#pragma once
+
+#include <stdint.h>
+
+#include "fdsurf/config/nodiscard.h"
+
+namespace fdsurf {
+namespace motion {
+
+class TurnCaps {
+ public:
+  /// Chords of 4 << k moves, k = 0..kChords-1.
+  static constexpr int kChords = 4;
+  static constexpr uint16_t kMaxChord = 4u << (kChords - 1);
+  /// Moves pushed but not final yet: those a chord still to come may cover.
+  static constexpr uint16_t kPendingMoves = 2 * kMaxChord - 1;
+  /// A power of two: the tick indexes the ring with a mask (a Cortex-M0
+  /// has no divide instruction).
+  static constexpr uint8_t kMaxRegions = 8;
+  /// Caps are kept as one-byte codes of B_c/a with three significant bits
+  /// (Coarsen() in turn_caps.cc), ordered as the values; this one is none.
+  static constexpr uint8_t kNoCap = 0xFF;
+  /// No constraint (a distance or braking bound larger than any).
+  static constexpr uint64_t kUnbounded = ~0ull;
+
+  /// For each chord, the doubled turn at or below which its cap cannot bind
+  /// (divides 64-bit numbers: ToTickLimits() calls it, outside any lock).
+  static void SkipThresholds(uint32_t turn_budget, uint32_t top_speed,
+                             uint32_t (&skip)[kChords]);
+  /// `turn_budget`: the largest centripetal acceleration, 2^-24 steps per
+  /// tick² (TickLimits::turn_budget; 0: nothing is capped); `accel` a;
+  /// `top_speed` the larger speed limit; `skip` from SkipThresholds().
+  /// Forgets everything (call at rest with nothing buffered). No division.
+  void Configure(uint32_t turn_budget, uint32_t accel, uint32_t top_speed,
+                 const uint32_t (&skip)[kChords]);
+  /// Forgets the moves and regions; the path coordinate restarts at 0.
+  void Clear();
+
+  /// What becomes final with one entry: `length` more of the path (2^-24
+  /// steps), when `capped` under the braking bound `braking` (B_c, a
+  /// multiple of a, worked out when measuring so that the commit only adds),
+  /// and with `stop` a stop region at its end.
+  struct Final {
+    uint64_t length;
+    uint64_t braking;
+    bool capped;
+    bool stop;
+  };
+
+  // Each entry is measured, then committed. Measuring is the costly half and
+  // touches nothing At() reads, so an MCU does it with the step interrupt
+  // enabled and masks it only for Commit() (a few additions). Every Final
+  // is committed before the next measurement.
+
+  /// Measures a unit move `length` long; returns the move that becomes final
+  /// (the one kPendingMoves back, or none yet).
+  Final Measure(uint8_t move, uint32_t length);
+  /// Makes every measured move final (the pending ones as one region under
+  /// their lowest cap) and starts a new window: no chord spans this point.
+  /// With `stop`, the loop must also come down to the lowest speed (a) here:
+  /// the path may turn any way after it (used when the producer has nothing
+  /// more for now; a pen event needs no stop, the loop rests there anyway).
+  Final MeasureAll(bool stop);
+  /// Makes `final` final: extends the final moves and appends its regions.
+  /// Needs HasRoom() beforehand.
+  void Commit(const Final& final);
+  /// Room for what the next Commit() may add (two regions).
+  FDSURF_NODISCARD bool HasRoom() const { return count_ + 2 < kMaxRegions; }
+  /// Moves measured that are not final yet.
+  FDSURF_NODISCARD bool HasPending() const { return final_end_ != pushed_end_; }
+  /// Path coordinate (2^-24 steps, from the last Clear()) where the final
+  /// moves end: the loop must be able to stop there.
+  FDSURF_NODISCARD uint64_t final_end() const { return final_end_; }
+
+  /// What the caps allow at path coordinate `position` (which only grows,
+  /// except that a pause may take it back to the start of the head move).
+  struct Bounds {
+    /// The braking distance B(n') the next speed may have (inside a region).
+    uint64_t braking;
+    /// Path coordinate bounding x + v' + B(n'): the end of the final moves
+    /// or the key of the next region, whichever is first.
+    uint64_t limit;
+  };
+  /// Drops the regions that end at or before `position`, then returns the
+  /// bounds there. Called on every tick: the bounds are kept until the
+  /// position reaches the next region boundary or a new region comes, so
+  /// most ticks cost one comparison. (A pause that takes the position
+  /// back keeps a started region's bound in force: stricter, never looser.)
+  Bounds At(uint64_t position) {
+    if (position >= valid_until_) Recompute(position);
+    return bounds_;
+  }
+
+ private:
+  struct Region {
+    uint64_t start;
+    uint64_t end;
+    /// start + B_c + a, B_c a multiple of a: inside the region B(n') ≤ B_c,
+    /// ahead of it v' + B(n') ≤ key − position.
+    uint64_t key;
+  };
+  static constexpr uint16_t kHistory = 2 * kMaxChord;
+  /// What rounding alone can add to a chord's turn: each point of a
+  /// step-exact path is the exact point rounded to whole steps (within half
+  /// a step on each axis, plus the engine's error of a hundredth), and d
+  /// weighs three points 1, 2, 1. The chords shorter than the longest allow
+  /// it; the longest does not.
+  static constexpr int kRoundingTurn = 2;
+
+  /// The cap of one chord (code of B_c/a), or kNoCap.
+  FDSURF_NODISCARD uint8_t CapOf(int chord, const int8_t (&turn)[3], uint32_t length) const;
+  FDSURF_NODISCARD Final FinalOf(uint64_t length, uint8_t cap, bool stop) const;
+  void AppendRegion(uint64_t start, uint64_t end, uint64_t braking);
+  void Recompute(uint64_t position);
+  void ResetWindow();
+
+  // Configuration.
+  uint32_t budget_ = 0;
+  uint32_t accel_ = 1;
+  uint32_t top_speed_ = 0;
+  /// A budget is set; without one every move is final at once.
+  bool limited_ = false;
+  /// A chord of kind k binds only if its doubled turn exceeds skip_[k].
+  uint32_t skip_[kChords] = {};
+
+  // The window of recent moves (since the last MeasureAll()).
+  uint8_t history_[kHistory] = {};
+  /// Per pending move, the lowest cap of the chords measured so far.
+  uint8_t pending_cap_[kHistory] = {};
+  uint8_t newest_ = 0;
+  uint16_t in_window_ = 0;
+  /// Per chord and axis, the sums of the newest m moves (ahead) and of the
+  /// m before them (behind): d = ahead − behind.
+  int8_t ahead_[kChords][3] = {};
+  int8_t behind_[kChords][3] = {};
+  uint32_t ahead_length_[kChords] = {};
+  uint32_t behind_length_[kChords] = {};
+
+  /// Where the measured moves end (the producer's alone) and where the final
+  /// ones end (written by Commit(), read by the tick).
+  uint64_t pushed_end_ = 0;
+  uint64_t final_end_ = 0;
+  Region regions_[kMaxRegions] = {};
+  /// At()'s answer, good while the position is below valid_until_.
+  Bounds bounds_ = {kUnbounded, 0};
+  uint64_t valid_until_ = 0;
+  /// The key in bounds_.limit (kUnbounded: none), so that Commit() can move
+  /// the limit with the final end without a recomputation.
+  uint64_t next_key_ = ~0ull;
+  uint8_t first_ = 0;
+  uint8_t count_ = 0;
+};
+
+}  // namespace motion
+}  // namespace fdsurf
