@@ -74,8 +74,10 @@ TEST_F(MachineCli, StreamWithTheSimProfileDrawsWhatTheSameFlagsDraw) {
   ASSERT_EQ(flags.exit_code, 0) << flags.err;
   EXPECT_EQ(Replace(profile.err, a, b), flags.err);
   EXPECT_EQ(Slurp(a), Slurp(b));
-  EXPECT_NE(profile.err.find("motion limits (80 mm/s, 1500 mm/s², pen delay 50 ms)"),
-            std::string::npos)
+  EXPECT_NE(
+      profile.err.find(
+          "motion limits (80 mm/s, 1500 mm/s² on the path, 3000 mm/s² per axis, pen delay 50 ms)"),
+      std::string::npos)
       << profile.err;
   // Without the profile the report differs: the comparison above can fail.
   EXPECT_NE(Replace(defaults.err, c, b), flags.err);
@@ -85,7 +87,10 @@ TEST_F(MachineCli, CommandLineBeatsTheProfile) {
   const RunResult r = Run("stream '" + kTeapot + "' --fit 240x160 --lines 2 --machine '" +
                           kMachines + "/sim.toml' --speed 60 --pen-delay 20");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("motion limits (60 mm/s, 1500 mm/s², pen delay 20 ms)"), std::string::npos)
+  EXPECT_NE(
+      r.err.find(
+          "motion limits (60 mm/s, 1500 mm/s² on the path, 3000 mm/s² per axis, pen delay 20 ms)"),
+      std::string::npos)
       << r.err;
 }
 

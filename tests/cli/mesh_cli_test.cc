@@ -224,7 +224,9 @@ TEST_F(MeshCli, StreamOfTheOctahedronDrawsTheSpheresDiscOnTheSimulatedPlotter) {
   EXPECT_NE(r.err.find("144 curves streamed to the simulated plotter"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("drawing vs exact curves: max deviation"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("(--tolerance): within"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("(400 mm/s, 10000 mm/s², pen delay 5 ms): kept"), std::string::npos)
+  EXPECT_NE(
+      r.err.find("(400 mm/s, 10000 mm/s² on the path, 20000 mm/s² per axis, pen delay 5 ms): kept"),
+      std::string::npos)
       << r.err;
   // What the plotter drew: a 20 mm drawing (30 mm page, 5 mm margins), so
   // the scale is 0.2; the stream's tolerance (0.05 mm), the pieces' scaled,

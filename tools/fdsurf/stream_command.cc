@@ -57,6 +57,8 @@ MachineOptions Machine(const StreamOptions& o) {
   m.accel = o.accel_limit ? *o.accel_limit : DefaultIn(m.accel, o.units);
   if (!(m.speed > 0) || !(m.accel > 0)) throw InputError("--speed and --accel must be above 0");
   m.travel_speed = o.travel_speed_limit ? *o.travel_speed_limit : m.speed;
+  m.axis_accel = o.axis_accel_limit ? *o.axis_accel_limit : 2 * m.accel;
+  if (!(m.axis_accel > 0)) throw InputError("--axis-accel must be above 0");
   if (!(m.travel_speed > 0)) throw InputError("--travel-speed must be above 0");
   m.pen_delay_ms = o.pen_delay_ms;
   m.servo_up_us = o.servo_pulse_up_us;
@@ -163,6 +165,9 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   command->add_option(
       "--accel", o->accel_limit,
       "path acceleration limit, --units per second² " + DefaultInMmHelp(mm.accel, "mm/s²"));
+  command->add_option("--axis-accel", o->axis_accel_limit,
+                      "each axis's acceleration limit, turning included, --units per second²; "
+                      "above --accel (default: twice --accel)");
   command->add_flag("--require-homing", o->require_homing,
                     "the device refuses to move until homed: run `fdsurf machine home` first");
 }
@@ -311,6 +316,7 @@ int RunStream(const StreamOptions& options) {
   o.speed = machine.speed;  // for the runners' summaries
   o.travel_speed = machine.travel_speed;
   o.accel = machine.accel;
+  o.axis_accel = machine.axis_accel;
   const PatchSet set = ReadDrawing(options.file, o.input_format, o.reader, o.layer, o.quiet);
   if (o.view.empty() && IsFlatDrawing(set)) drawing.view = ParseView("top");
   const std::string file_units = set.units.empty() ? "mm" : set.units;

@@ -89,7 +89,8 @@ TEST(MachineProfile, KeysOfFeaturesToComeSaySo) {
   EXPECT_NE(RefusalOf("home = true\n").find("key 'home': the key is 'homing', a table"),
             std::string::npos);
   EXPECT_NE(RefusalOf("origin = [0, 0]\n").find("not supported yet"), std::string::npos);
-  EXPECT_NE(RefusalOf("accel_x = 3\n").find("not supported yet"), std::string::npos);
+  EXPECT_NE(RefusalOf("accel_x = 3\n").find("not supported yet: give 'axis_accel'"),
+            std::string::npos);
   EXPECT_NE(RefusalOf("steps_per_mm = 80\n").find("not supported yet"), std::string::npos);
 }
 

@@ -143,11 +143,20 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   config.max_rate = static_cast<std::uint32_t>(max_rate);
   config.accel = static_cast<std::uint32_t>(accel);
   config.pen_delay_ms = static_cast<std::uint16_t>(machine.pen_delay_ms);
-  // Protocol 3 fields: the pen-up speed limit, and (no per-axis limit yet)
-  // the path acceleration, what an axis-aligned move already demands of an
-  // axis.
+  // Protocol 3 fields: the pen-up speed limit, and each axis's limit, whose
+  // excess over the path's acceleration the device leaves for turning.
   config.travel_rate = static_cast<std::uint32_t>(travel_rate);
-  for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = config.accel;
+  const double axis_accel =
+      machine.axis_accel > 0 ? std::floor(machine.axis_accel / step) : 2 * accel;
+  if (!(axis_accel > accel && axis_accel < 4e9)) {
+    throw OptionError(
+        "axis accel",
+        FormatNumber(machine.axis_accel > 0 ? machine.axis_accel : 2 * machine.accel) + " " +
+            units + "/s²",
+        "is not above the path's accel (" + FormatNumber(machine.accel) + " " + units +
+            "/s²): the excess is what turning may use");
+  }
+  for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = static_cast<std::uint32_t>(axis_accel);
   SetServoPulses(machine, &config);
   config.flags = machine.homing_required ? protocol::kConfigFlagHomingRequired : 0;
   return config;

@@ -89,6 +89,7 @@ struct Targets {
     if (flag == "--require-homing") return "false";
     if (flag == "--travel") return "the page";
     if (flag == "--travel-speed") return "--speed";
+    if (flag == "--axis-accel") return "twice --accel";
     if (flag == "--tick-hz") return "the device's";
     return "(built in)";
   }

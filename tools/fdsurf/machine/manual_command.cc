@@ -93,11 +93,16 @@ protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz) {
   config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / s.step)));
   config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
   // Jogs and gotos run with the pen up, so at the travel speed; each axis
-  // gets the path's acceleration, as stream gives it (ConfigFor).
+  // gets the limit stream gives it (ConfigFor).
   const double travel_speed = s.machine.travel_speed > 0 ? s.machine.travel_speed : s.machine.speed;
   const double travel_rate = std::floor(travel_speed / s.step);
   config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
-  for (int a = 0; a < s.axes; ++a) config.axis_accel[a] = config.accel;
+  const double axis_accel =
+      s.machine.axis_accel > 0 ? std::floor(s.machine.axis_accel / s.step) : 2.0 * config.accel;
+  for (int a = 0; a < s.axes; ++a) {
+    config.axis_accel[a] =
+        static_cast<std::uint32_t>(std::clamp(axis_accel, config.accel + 1.0, 4e9));
+  }
   config.flags = s.stream.require_homing ? protocol::kConfigFlagHomingRequired : 0;
   return config;
 }

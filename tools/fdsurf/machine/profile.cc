@@ -28,9 +28,9 @@ constexpr PlannedKey kPlannedKeys[] = {
     {"home", "the key is 'homing', a table: [homing] axes, toward, rate, backoff, required"},
     {"steps_per_mm", "steps per unit are not supported yet: give 'step', the length of one step"},
     {"steps_per_in", "steps per unit are not supported yet: give 'step', the length of one step"},
-    {"accel_x", "acceleration per axis is not supported yet: give 'accel', the path's"},
-    {"accel_y", "acceleration per axis is not supported yet: give 'accel', the path's"},
-    {"accel_z", "acceleration per axis is not supported yet: give 'accel', the path's"},
+    {"accel_x", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
+    {"accel_y", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
+    {"accel_z", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
     {"origin", "the machine's origin is not supported yet (stream --origin places the page)"},
 };
 
@@ -261,6 +261,8 @@ const std::vector<MachineKey>& MachineKeys() {
        "stream: path speed limit with the pen up (default: speed)"},
       {"accel", T::kLength, "units/s²", "--accel", C::kPositive,
        "stream: path acceleration limit; plot G-code: the time estimate's"},
+      {"axis_accel", T::kLength, "units/s²", "--axis-accel", C::kPositive,
+       "stream: each axis's acceleration limit, turning included (default: twice accel)"},
       {"pen_delay", T::kInteger, "ms", "--pen-delay", C::kNone,
        "stream: rest after each pen change"},
       {"servo_pulse_up", T::kInteger, "µs", "--servo-pulse-up", C::kNone,

@@ -162,6 +162,7 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   limits.max_rate = job.config.max_rate;
   limits.travel_rate = job.config.travel_rate;
   limits.accel = job.config.accel;
+  limits.axis_accel = job.config.axis_accel[0];
   limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
   checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
   checked.bound = job.tolerance_steps + 0.005;
@@ -264,14 +265,12 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
       checked.limits_kept
           ? std::string("kept")
           : std::to_string(motion.violations) + " violations, first: " + motion.first_violation;
-  // The profile limits the path's acceleration, not each axis's (the
-  // centripetal part on curves): the axes' is reported, not checked.
   std::fprintf(stderr,
-               "motion limits (%s %s/s%s, %s %s/s², pen delay %d ms): %s; axis acceleration %s "
-               "%s/s² (not limited)\n",
+               "motion limits (%s %s/s%s, %s %s/s² on the path, %s %s/s² per axis, pen delay %d "
+               "ms): %s\n",
                FormatNumber(o.speed).c_str(), units.c_str(), TravelSpeedNote(o, units).c_str(),
-               FormatNumber(o.accel).c_str(), units.c_str(), o.pen_delay_ms, limits.c_str(),
-               FormatNumber(axis_accel[fastest_axis] * step, 4).c_str(), units.c_str());
+               FormatNumber(o.accel).c_str(), units.c_str(), FormatNumber(o.axis_accel).c_str(),
+               units.c_str(), o.pen_delay_ms, limits.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
   if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
   if (!o.png.empty()) {
