@@ -49,8 +49,12 @@ static_assert(kServoUpUs >= 500 && kServoUpUs <= 2500 && kServoDownUs >= 500 &&
 /// Device sizes: commands that can wait (the host's credit) and unit moves
 /// buffered ahead of the motion. They and the validation's stack share the
 /// 8 KB of RAM (README.md has the measured budget).
+/// 128 entries: the turn caps (fdsurf/motion/turn_caps.h) took about 600 B
+/// of RAM, and at this board's speeds (2000 ticks/s, 1600 steps/s and
+/// 2000 mm/s² in the tests: 8 steps of braking) the 63 moves the caps keep
+/// pending and 65 final ones are plenty.
 constexpr int kQueueCapacity = 4;
-constexpr int kLookahead = 256;
+constexpr int kLookahead = 128;
 /// Entries Device::Fill() may push before the main loop services the link
 /// again: expanding a point costs about 13 000 cycles here, so 16 is about
 /// 15 ms (README.md).

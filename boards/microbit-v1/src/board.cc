@@ -82,15 +82,43 @@ struct Uart {
   }
 };
 
-/// STEP/DIR/ENABLE of two A4988/DRV8825 drivers and the PEN line.
+/// STEP/DIR/ENABLE of two A4988/DRV8825 drivers and the PEN line, driven
+/// one tick late: what Device::Tick() asks for is recorded, and Emit(),
+/// first thing in the next tick interrupt, drives it. The pins then change a
+/// fixed time after each compare, however long the tick's computation took
+/// (from ~150 to ~700 cycles of the 800-cycle period: the turn caps'
+/// bookkeeping varies), so consecutive moves stay a whole tick apart.
 class PinOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
  public:
   PinOutputs() : hal::StepDirOutputs(2) {}
   ~PinOutputs() = default;
 
+  /// Drives what the previous tick recorded, in the order the device asked:
+  /// the pen, the enable line, the directions (then their set-up time), the
+  /// STEP pulses.
+  void Emit() {
+    if (pen_set_) Reg(pen_down_ ? nrf51::kGpioOutSet : nrf51::kGpioOutClr) = pins::Bit(pins::kPen);
+    if (enable_set_) {
+      Reg(enabled_ ? nrf51::kGpioOutClr : nrf51::kGpioOutSet) = pins::Bit(pins::kEnable);
+    }
+    if (directions_set_) {
+      Reg(nrf51::kGpioOutSet) = negative_bits_;
+      Reg(nrf51::kGpioOutClr) = (pins::kDirBits[0] | pins::kDirBits[1]) & ~negative_bits_;
+      Delay(kDirSetupLoops);
+    }
+    if (step_bits_ != 0) {
+      Reg(nrf51::kGpioOutSet) = step_bits_;
+      Delay(kStepHighLoops);
+      Reg(nrf51::kGpioOutClr) = step_bits_;
+    }
+    pen_set_ = enable_set_ = directions_set_ = false;
+    step_bits_ = 0;
+  }
+
  private:
   hal::IoStatus DoSetEnabled(bool enabled) override {
-    Reg(enabled ? nrf51::kGpioOutClr : nrf51::kGpioOutSet) = pins::Bit(pins::kEnable);
+    enabled_ = enabled;
+    enable_set_ = true;
     return hal::IoStatus::kOk;
   }
   hal::IoStatus DoSetDirections(uint8_t negative_mask) override {
@@ -99,26 +127,31 @@ class PinOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
     for (int a = 0; a < 2; ++a) {
       if ((negative_mask >> a) & 1u) negative |= pins::kDirBits[a];
     }
-    Reg(nrf51::kGpioOutSet) = negative;
-    Reg(nrf51::kGpioOutClr) = (pins::kDirBits[0] | pins::kDirBits[1]) & ~negative;
-    Delay(kDirSetupLoops);
+    negative_bits_ = negative;
+    directions_set_ = true;
     return hal::IoStatus::kOk;
   }
   hal::IoStatus DoStep(uint8_t axis_mask) override {
     if ((axis_mask & ~axis_bits()) != 0) return hal::IoStatus::kInvalidArgument;
-    const uint32_t bits =
+    step_bits_ |=
         ((axis_mask & 1u) ? pins::kStepBits[0] : 0u) | ((axis_mask & 2u) ? pins::kStepBits[1] : 0u);
-    if (bits == 0) return hal::IoStatus::kOk;
-    Reg(nrf51::kGpioOutSet) = bits;
-    Delay(kStepHighLoops);
-    Reg(nrf51::kGpioOutClr) = bits;
     return hal::IoStatus::kOk;
   }
   hal::IoStatus DoSetPen(bool down) override {
-    Reg(down ? nrf51::kGpioOutSet : nrf51::kGpioOutClr) = pins::Bit(pins::kPen);
+    pen_down_ = down;
+    pen_set_ = true;
     return hal::IoStatus::kOk;
   }
   const char* DoLastError() const override { return ""; }
+
+  // Recorded by the tick, driven by the next one's Emit().
+  uint32_t negative_bits_ = 0;
+  uint32_t step_bits_ = 0;
+  bool enabled_ = false;
+  bool pen_down_ = false;
+  bool enable_set_ = false;
+  bool directions_set_ = false;
+  bool pen_set_ = false;
 };
 
 // 256 lookahead entries hold the braking distance up to ~110 mm/s at
@@ -270,6 +303,7 @@ void fdsurf_board_timer_irq() {
     if (g_device.motion().speed() != 0) ++stats.late_moving_ticks;
   }
   if (lateness > stats.max_lateness) stats.max_lateness = lateness;
+  g_outputs.Emit();  // the previous tick's outputs, at a fixed time after the compare
   const uint32_t moves = g_device.motion().moves();
   (void)g_device.Tick(g_outputs, g_outputs);
   const uint32_t cycles = CaptureTimer(1) - entry;
