@@ -39,8 +39,7 @@ uint64_t UnitsOf(uint8_t code) {
 
 }  // namespace
 
-void TurnCaps::SkipThresholds(uint32_t turn_budget, uint32_t top_speed,
-                              uint32_t (&skip)[kChords]) {
+void TurnCaps::SkipThresholds(uint32_t turn_budget, uint32_t top_speed, uint32_t (&skip)[kChords]) {
   const uint64_t top_squared = static_cast<uint64_t>(top_speed) * top_speed;
   for (int k = 0; k < kChords; ++k) {
     // Every move is at least 2^24 long, so a chord of m moves has
@@ -48,8 +47,7 @@ void TurnCaps::SkipThresholds(uint32_t turn_budget, uint32_t top_speed,
     // (no cap) while the doubled turn T ≤ 2·budget·m²·2^24 / top².
     const uint64_t m = 4u << k;
     const uint64_t bound =
-        top_squared == 0 ? ~0ull
-                         : ((2ull * turn_budget * m * m) << kLengthFracBits) / top_squared;
+        top_squared == 0 ? ~0ull : ((2ull * turn_budget * m * m) << kLengthFracBits) / top_squared;
     skip[k] = bound > 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<uint32_t>(bound);
   }
 }

@@ -55,8 +55,7 @@ class TurnCaps {
 
   /// For each chord, the doubled turn at or below which its cap cannot bind
   /// (divides 64-bit numbers: ToTickLimits() calls it, outside any lock).
-  static void SkipThresholds(uint32_t turn_budget, uint32_t top_speed,
-                             uint32_t (&skip)[kChords]);
+  static void SkipThresholds(uint32_t turn_budget, uint32_t top_speed, uint32_t (&skip)[kChords]);
   /// `turn_budget`: the largest centripetal acceleration, 2^-24 steps per
   /// tick² (TickLimits::turn_budget; 0: nothing is capped); `accel` a;
   /// `top_speed` the larger speed limit; `skip` from SkipThresholds().
