@@ -178,7 +178,7 @@ TurnCaps::Final TurnCaps::MeasureAll(bool stop) {
 }
 
 void TurnCaps::Recompute(uint64_t position) {
-  while (count_ > 0 && regions_[first_].end <= position) {
+  while (count_ > 0 && regions_[first_].End() <= position) {
     first_ = static_cast<uint8_t>((first_ + 1) & (kMaxRegions - 1));
     --count_;
   }
@@ -189,14 +189,14 @@ void TurnCaps::Recompute(uint64_t position) {
   const Region& front = regions_[first_];
   uint8_t ahead = 0;
   if (front.start <= position) {
-    bounds_.braking = front.key - front.start - accel_;
-    valid_until_ = front.end;
+    bounds_.braking = front.reach - accel_;
+    valid_until_ = front.End();
     ahead = 1;
   } else {
     valid_until_ = front.start;
   }
   if (count_ > ahead) {
-    next_key_ = regions_[(first_ + ahead) & (kMaxRegions - 1)].key;
+    next_key_ = regions_[(first_ + ahead) & (kMaxRegions - 1)].Key();
     if (next_key_ < bounds_.limit) bounds_.limit = next_key_;
   }
 }
@@ -215,28 +215,34 @@ void TurnCaps::Commit(const Final& final) {
 
 TurnCaps::Final TurnCaps::FinalOf(uint64_t length, uint8_t cap, bool stop) const {
   if (cap == kNoCap) return Final{length, 0, false, stop};
-  return Final{length, UnitsOf(cap) * accel_, true, stop};
+  uint64_t braking = UnitsOf(cap) * accel_;
+  // Region::reach = B_c + a below 2^32: a lower multiple of a (a lower cap).
+  const uint64_t most = (0xFFFFFFFFull - accel_) / accel_ * accel_;
+  if (braking > most) braking = most;
+  return Final{length, braking, true, stop};
 }
 
 void TurnCaps::AppendRegion(uint64_t start, uint64_t end, uint64_t braking) {
-  const uint64_t key = start + braking + accel_;
+  const uint32_t reach = static_cast<uint32_t>(braking + accel_);  // < 2^32 (FinalOf)
+  const uint64_t key = start + reach;
   if (count_ > 0) {
     Region& back = regions_[(first_ + count_ - 1) & (kMaxRegions - 1)];
     // The same cap right after: one longer region (nothing ahead of it
-    // changes; its key, start + B_c + a, stays).
-    if (back.end == start && back.key - back.start == key - start) {
+    // changes; its key, start + B_c + a, stays), while it fits.
+    if (back.End() == start && back.reach == reach && end - back.start <= 0xFFFFFFFFu) {
       // At() holds the bounds until `start` only when this is the started
       // front region (any other front starts before it, or ends earlier).
       if (valid_until_ == start) valid_until_ = end;
-      back.end = end;
+      back.length = static_cast<uint32_t>(end - back.start);
       return;
     }
   }
   valid_until_ = 0;  // At() recomputes
   // A region behind with a key at or above this one's is dominated: ahead of
   // it and inside it, this key's bound is the tighter (docs/motion.md).
-  while (count_ > 0 && regions_[(first_ + count_ - 1) & (kMaxRegions - 1)].key >= key) --count_;
-  regions_[(first_ + count_) & (kMaxRegions - 1)] = Region{start, end, key};
+  while (count_ > 0 && regions_[(first_ + count_ - 1) & (kMaxRegions - 1)].Key() >= key) --count_;
+  regions_[(first_ + count_) & (kMaxRegions - 1)] =
+      Region{start, static_cast<uint32_t>(end - start), reach};
   ++count_;
 }
 

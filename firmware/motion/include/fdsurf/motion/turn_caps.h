@@ -121,12 +121,17 @@ class TurnCaps {
   }
 
  private:
+  /// 16 bytes (the Mega's RAM is counted): a region is at most 2^32 − 1
+  /// long (a longer run starts a new one) and B_c + a is clamped below 2^32
+  /// (a lower cap, conservative) when measured.
   struct Region {
     uint64_t start;
-    uint64_t end;
-    /// start + B_c + a, B_c a multiple of a: inside the region B(n') ≤ B_c,
-    /// ahead of it v' + B(n') ≤ key − position.
-    uint64_t key;
+    uint32_t length;
+    /// B_c + a, B_c a multiple of a: inside the region B(n') ≤ B_c, ahead of
+    /// it v' + B(n') ≤ key − position with key = start + reach.
+    uint32_t reach;
+    FDSURF_NODISCARD uint64_t End() const { return start + length; }
+    FDSURF_NODISCARD uint64_t Key() const { return start + reach; }
   };
   static constexpr uint16_t kHistory = 2 * kMaxChord;
   /// What rounding alone can add to a chord's turn: each point of a
