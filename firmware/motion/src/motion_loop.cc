@@ -74,15 +74,10 @@ void MotionLoop::Configure(const TickLimits& limits) {
   head_start_ = 0;
 }
 
-uint32_t MotionLoop::LengthOf(uint8_t move) {
-  int axes = 0;
-  for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
-  return kMoveLength[axes];
-}
-
 MotionLoop::PreparedEntry MotionLoop::Prepare(uint8_t entry) {
   const EntryKind kind = KindOf(entry);
-  if (kind == EntryKind::kMove) return PreparedEntry{entry, caps_.Measure(entry, LengthOf(entry))};
+  if (kind == EntryKind::kMove)
+    return PreparedEntry{entry, caps_.Measure(entry, LengthOfMove(entry))};
   // The loop rests at a pen event: no chord spans it.
   if (kind == EntryKind::kPenUp || kind == EntryKind::kPenDown) {
     return PreparedEntry{entry, caps_.MeasureAll(false)};
@@ -101,14 +96,14 @@ bool MotionLoop::Push(const PreparedEntry& prepared) {
     ++stops_;
   } else if (kind == EntryKind::kMove) {
     uint64_t& run = stops_ == 0 ? distance_ : runs_[(first_run_ + stops_ - 1) % kMaxPenEvents];
-    run += LengthOf(entry);
+    run += LengthOfMove(entry);
   }
   caps_.Commit(prepared.final);
   return true;
 }
 
 void MotionLoop::Pop() {
-  if (KindOf(At(0)) == EntryKind::kMove) head_start_ += LengthOf(At(0));
+  if (KindOf(At(0)) == EntryKind::kMove) head_start_ += LengthOfMove(At(0));
   head_ = static_cast<uint16_t>((head_ + 1) & mask_);
   --count_;
 }
@@ -222,7 +217,7 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
   }
   phase_ += static_cast<uint32_t>(advance);
   const uint8_t head = At(0);
-  const uint32_t length = LengthOf(head);
+  const uint32_t length = LengthOfMove(head);
   if (phase_ >= length) {
     phase_ -= length;
     distance_ -= length;

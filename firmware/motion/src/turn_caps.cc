@@ -14,12 +14,6 @@ int8_t StepOf(uint8_t move, int axis) {
   return (bits & 2) != 0 ? -1 : 1;
 }
 
-uint32_t LengthOfMove(uint8_t move) {
-  int axes = 0;
-  for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
-  return kMoveLength[axes];
-}
-
 // B_c/a rounded down to three significant bits, as a one-byte code that
 // orders as the values: 0..7 as they are, then 8·(s + 1) + (v >> s) − 8 for
 // v >> s in 8..15. Neighbouring moves on a smooth curve then share one

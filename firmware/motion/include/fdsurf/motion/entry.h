@@ -41,5 +41,13 @@ constexpr int kLengthFracBits = 24;
 /// that a diagonal move is never taken as shorter than it is.
 constexpr uint32_t kMoveLength[4] = {0, 16777216u, 23726567u, 29058991u};
 
+/// The length of a unit move entry, 2^-24 steps (kMoveLength of the axes
+/// it steps).
+inline uint32_t LengthOfMove(uint8_t move) {
+  int axes = 0;
+  for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
+  return kMoveLength[axes];
+}
+
 }  // namespace motion
 }  // namespace fdsurf

@@ -208,7 +208,6 @@ class MotionLoop {
  private:
   FDSURF_NODISCARD uint8_t At(uint16_t offset) const { return storage_[(head_ + offset) & mask_]; }
   void Pop();
-  static uint32_t LengthOf(uint8_t move);
 
   uint8_t* storage_;
   uint16_t capacity_;

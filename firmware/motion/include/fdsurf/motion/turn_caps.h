@@ -97,9 +97,6 @@ class TurnCaps {
   FDSURF_NODISCARD bool HasRoom() const { return count_ + 2 < kMaxRegions; }
   /// Moves measured that are not final yet.
   FDSURF_NODISCARD bool HasPending() const { return final_end_ != pushed_end_; }
-  /// Path coordinate (2^-24 steps, from the last Clear()) where the final
-  /// moves end: the loop must be able to stop there.
-  FDSURF_NODISCARD uint64_t final_end() const { return final_end_; }
 
   /// What the caps allow at path coordinate `position` (which only grows,
   /// except that a pause may take it back to the start of the head move).
