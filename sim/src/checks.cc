@@ -342,15 +342,17 @@ void CheckWindowAccel(double window_s, MotionCheck& c) {
 // progress, either way), so each change errs by under 4/W and the test
 // allows axis_accel·W + 4/W (docs/motion.md).
 void CheckWindowAxisAccel(double window_s, MotionCheck& c) {
-  const double allowance = c.limits.axis_accel * window_s + 4 / window_s;
   for (int axis = 0; axis < 3; ++axis) {
+    const double own = c.limits.axis_accel_each[static_cast<std::size_t>(axis)];
+    const double limit = own > 0 ? own : c.limits.axis_accel;
+    const double allowance = limit * window_s + 4 / window_s;
     double& largest = c.report.max_axis_accel[axis];
     ForEachWindowChange(
         c.time, window_s, [&](std::size_t k) { return static_cast<double>(c.position[k][axis]); },
         [&](double t, double signed_change) {
           const double change = std::fabs(signed_change);
           largest = std::max(largest, change / window_s);
-          if (c.limits.axis_accel > 0 && change > allowance + 1e-9) {
+          if (limit > 0 && change > allowance + 1e-9) {
             c.Violation(std::string("axis ") + "XYZ"[axis] +
                         Describe(": its velocity changed by %.1f steps/s in the %.3f s window at "
                                  "%.6f s (axis accel limit allows %.1f)",

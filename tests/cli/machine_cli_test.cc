@@ -83,6 +83,30 @@ TEST_F(MachineCli, StreamWithTheSimProfileDrawsWhatTheSameFlagsDraw) {
   EXPECT_NE(Replace(defaults.err, c, b), flags.err);
 }
 
+// steps_per_mm and accel_x/accel_y draw what --step and --accel-x/-y draw,
+// and the summary names each axis's limit.
+TEST_F(MachineCli, StepsPerMmAndAxisLimitsAreTheFlagsOfTheSameName) {
+  const std::string profile =
+      Write("axes.toml", "steps_per_mm = [100, 100]\naccel_x = 5000\naccel_y = 3000\n");
+  const std::string drawing = "stream '" + kTeapot + "' --fit 120x80 --lines 2 --waveform ";
+  const std::string a = (dir_ / "profile.wave").string();
+  const std::string b = (dir_ / "flags.wave").string();
+  const RunResult from_profile = Run(drawing + "'" + a + "' --machine '" + profile + "'");
+  const RunResult from_flags =
+      Run(drawing + "'" + b + "' --step 0.01 --accel-x 5000 --accel-y 3000");
+  ASSERT_EQ(from_profile.exit_code, 0) << from_profile.err;
+  ASSERT_EQ(from_flags.exit_code, 0) << from_flags.err;
+  EXPECT_EQ(Replace(from_profile.err, a, b), from_flags.err);
+  EXPECT_EQ(Slurp(a), Slurp(b));
+  EXPECT_NE(from_flags.err.find("2000 mm/s² on the path, X 5000, Y 3000 mm/s² per axis"),
+            std::string::npos)
+      << from_flags.err;
+  // Another step draws another waveform: the comparison above can fail.
+  const std::string c = (dir_ / "other.wave").string();
+  ASSERT_EQ(Run(drawing + "'" + c + "' --step 0.0125 --accel-x 5000 --accel-y 3000").exit_code, 0);
+  EXPECT_NE(Slurp(c), Slurp(b));
+}
+
 TEST_F(MachineCli, CommandLineBeatsTheProfile) {
   const RunResult r = Run("stream '" + kTeapot + "' --fit 240x160 --lines 2 --machine '" +
                           kMachines + "/sim.toml' --speed 60 --pen-delay 20");

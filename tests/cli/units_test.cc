@@ -40,7 +40,7 @@ const std::map<std::string, std::set<std::string>> kCovered = {
     // StreamOptionsAgreeInBothUnits (and StreamDefaultsInInchesWork).
     {"stream",
      {"--fit", "--margin", "--tolerance", "--step", "--travel", "--speed", "--travel-speed",
-      "--accel", "--axis-accel"}},
+      "--accel", "--axis-accel", "--accel-x", "--accel-y", "--accel-z"}},
 };
 
 // One G-code program's physical content, in mm.
@@ -331,12 +331,12 @@ TEST_F(Units, StreamOptionsAgreeInBothUnits) {
   // The same machine and page in both units (each value exactly 25.4x the
   // other): the plotter makes the very same steps, pin for pin.
   const std::string mm_flags =
-      "--step 0.0127 --speed 50.8 --travel-speed 101.6 --accel 2540 --axis-accel 3810 --margin "
-      "12.7 "
+      "--step 0.0127 --speed 50.8 --travel-speed 101.6 --accel 2540 --axis-accel 3810 --accel-x "
+      "3302 --accel-y 3048 --accel-z 4064 --margin 12.7 "
       "--fit 254x203.2 --tolerance 0.127 --travel 254x203.2";
   const std::string inch_flags =
-      "--step 0.0005 --speed 2 --travel-speed 4 --accel 100 --axis-accel 150 --margin 0.5 --fit "
-      "10x8 "
+      "--step 0.0005 --speed 2 --travel-speed 4 --accel 100 --axis-accel 150 --accel-x 130 "
+      "--accel-y 120 --accel-z 160 --margin 0.5 --fit 10x8 "
       "--tolerance 0.005 --travel 10x8";
   std::string waves[2];
   std::string summaries[2];

@@ -26,7 +26,7 @@ constexpr double kWindow = 0.02;  // CheckMotion's default
 constexpr std::uint32_t kMaxRate = 8000;
 constexpr std::uint32_t kAccel = 160000;
 
-protocol::Command Config(std::uint32_t axis_accel) {
+protocol::Command Config(std::uint32_t axis_accel, std::uint32_t y_axis_accel = 0) {
   protocol::Command config;
   config.type = protocol::MessageType::kConfig;
   config.body.config = protocol::MachineConfig{};
@@ -37,7 +37,8 @@ protocol::Command Config(std::uint32_t axis_accel) {
   config.body.config.accel = kAccel;
   config.body.config.pen_delay_ms = 5;
   config.body.config.travel_rate = kMaxRate;
-  config.body.config.axis_accel[0] = config.body.config.axis_accel[1] = axis_accel;
+  config.body.config.axis_accel[0] = axis_accel;
+  config.body.config.axis_accel[1] = y_axis_accel != 0 ? y_axis_accel : axis_accel;
   return config;
 }
 
@@ -112,12 +113,15 @@ struct CircleRun {
 // Three laps of a circle of radius r steps round (500, 500), the middle one
 // at the speed the device allows there, checked against the path limits and
 // an axis limit of twice the path's acceleration.
-CircleRun DrawCircle(double r, std::uint32_t axis_accel) {
+// `y_axis_accel` (0: `axis_accel`) gives Y a limit of its own in CONFIG;
+// `checked` (when set) replaces the check's twice-the-path's per axis.
+CircleRun DrawCircle(double r, std::uint32_t axis_accel, std::uint32_t y_axis_accel = 0,
+                     const std::array<double, 3>& checked = {0, 0, 0}) {
   constexpr double cx = 500;
   constexpr double cy = 500;
   SimulatedPlotter plotter(PlotterOptions{});
   host::HostLink link;
-  EXPECT_TRUE(link.Enqueue(Config(axis_accel), "config").ok());
+  EXPECT_TRUE(link.Enqueue(Config(axis_accel, y_axis_accel), "config").ok());
   for (const protocol::Command& command : Circle(cx, cy, r, 3)) {
     EXPECT_TRUE(link.Enqueue(command, "circle").ok());
   }
@@ -131,6 +135,7 @@ CircleRun DrawCircle(double r, std::uint32_t axis_accel) {
   const MotionReport path = CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
   EXPECT_EQ(path.violations, 0u) << path.first_violation;
   limits.axis_accel = 2.0 * kAccel;
+  limits.axis_accel_each = checked;
   CircleRun result{CheckMotion(plotter.step_events(), plotter.pen_events(), limits), 0};
   // The travel to the start crosses y = cy too: crossings 1 and 2 bound the
   // middle lap.
@@ -173,6 +178,24 @@ TEST(AxisAcceleration, TurnCapsKeepEachAxisWithinItsLimitOnATightCircle) {
   for (int axis = 0; axis < 2; ++axis) {
     EXPECT_LT(run.axes.max_axis_accel[axis], 2.0 * kAccel + 4 / (kWindow * kWindow)) << axis;
   }
+}
+
+// Per-axis limits (profile accel_x/accel_y, CONFIG axis_accel[a]): the
+// device keeps every axis within the smallest, and the check holds each axis
+// to its own.
+TEST(AxisAcceleration, EachAxisIsKeptWithinItsOwnLimit) {
+  const std::array<double, 3> own{4.0 * kAccel, 2.0 * kAccel, 0};
+  const CircleRun run = DrawCircle(kRadius, 4 * kAccel, 2 * kAccel, own);
+  EXPECT_EQ(run.axes.violations, 0u) << run.axes.first_violation;
+  for (int axis = 0; axis < 2; ++axis) {
+    EXPECT_LT(run.axes.max_axis_accel[axis], 2.0 * kAccel + 4 / (kWindow * kWindow)) << axis;
+  }
+  // The same drawing held to a Y limit below what Y reached (about 1.1·kAccel
+  // measured): the check names Y, and X (within 4·kAccel) is not named.
+  const CircleRun strict =
+      DrawCircle(kRadius, 4 * kAccel, 2 * kAccel, {4.0 * kAccel, 0.8 * kAccel, 0});
+  EXPECT_GT(strict.axes.violations, 0u);
+  EXPECT_EQ(strict.axes.first_violation.rfind("axis Y", 0), 0u) << strict.axes.first_violation;
 }
 
 }  // namespace

@@ -20,6 +20,9 @@
 namespace fdsurf::host {
 namespace {
 
+// The flags of one axis's acceleration limit, x, y, z.
+constexpr const char* kAxisAccelFlags[3] = {"--accel-x", "--accel-y", "--accel-z"};
+
 ToolpathOptions DrawingOptions(const StreamOptions& o) {
   ToolpathOptions t;
   t.tolerance = o.tolerance.empty() ? DefaultIn(ToolpathOptions{}.tolerance, o.units)
@@ -57,8 +60,13 @@ MachineOptions Machine(const StreamOptions& o) {
   m.accel = o.accel_limit ? *o.accel_limit : DefaultIn(m.accel, o.units);
   if (!(m.speed > 0) || !(m.accel > 0)) throw InputError("--speed and --accel must be above 0");
   m.travel_speed = o.travel_speed_limit ? *o.travel_speed_limit : m.speed;
-  m.axis_accel = o.axis_accel_limit ? *o.axis_accel_limit : 2 * m.accel;
-  if (!(m.axis_accel > 0)) throw InputError("--axis-accel must be above 0");
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::optional<double>& own = o.axis_accel_each[a];
+    m.axis_accel[a] = own ? *own : o.axis_accel_limit ? *o.axis_accel_limit : 2 * m.accel;
+    if (!(m.axis_accel[a] > 0)) {
+      throw InputError(std::string(own ? kAxisAccelFlags[a] : "--axis-accel") + " must be above 0");
+    }
+  }
   if (!(m.travel_speed > 0)) throw InputError("--travel-speed must be above 0");
   m.pen_delay_ms = o.pen_delay_ms;
   m.servo_up_us = o.servo_pulse_up_us;
@@ -168,6 +176,12 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   command->add_option("--axis-accel", o->axis_accel_limit,
                       "each axis's acceleration limit, turning included, --units per second²; "
                       "above --accel (default: twice --accel)");
+  for (std::size_t a = 0; a < 3; ++a) {
+    command->add_option(kAxisAccelFlags[a], o->axis_accel_each[a],
+                        std::string("the ") + "XYZ"[a] +
+                            " axis's acceleration limit, --units per second² (default: "
+                            "--axis-accel); the device keeps every axis within the smallest");
+  }
   command->add_flag("--require-homing", o->require_homing,
                     "the device refuses to move until homed: run `fdsurf machine home` first");
 }

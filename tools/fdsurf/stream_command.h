@@ -48,11 +48,13 @@ struct StreamOptions {
   std::optional<double> accel_limit;
   /// --axis-accel, --units per second²; unset: twice the path's.
   std::optional<double> axis_accel_limit;
+  /// --accel-x, --accel-y, --accel-z: one axis's limit, over --axis-accel.
+  std::array<std::optional<double>, 3> axis_accel_each;
   /// The limits in effect, in --units: set by RunStream for the runners.
   double speed = 0;
   double travel_speed = 0;  ///< pen up; the runners' summaries name it when ≠ speed
   double accel = 0;
-  double axis_accel = 0;  ///< each axis's limit (MachineOptions::axis_accel)
+  std::array<double, 3> axis_accel{};  ///< each axis's limit (MachineOptions::axis_accel)
   int pen_delay_ms = 100;
   /// The servo pen lift's pulse widths, µs; both 0: a switch pen.
   int servo_pulse_up_us = 0;

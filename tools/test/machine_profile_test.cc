@@ -89,9 +89,16 @@ TEST(MachineProfile, KeysOfFeaturesToComeSaySo) {
   EXPECT_NE(RefusalOf("home = true\n").find("key 'home': the key is 'homing', a table"),
             std::string::npos);
   EXPECT_NE(RefusalOf("origin = [0, 0]\n").find("not supported yet"), std::string::npos);
-  EXPECT_NE(RefusalOf("accel_x = 3\n").find("not supported yet: give 'axis_accel'"),
-            std::string::npos);
-  EXPECT_NE(RefusalOf("steps_per_mm = 80\n").find("not supported yet"), std::string::npos);
+}
+
+TEST(MachineProfile, AxisLimitsAreKeysOfTheirOwn) {
+  const MachineProfile p =
+      ParseMachineProfile("units = \"in\"\naccel_x = 100\naccel_y = 80\n", "m.toml");
+  ASSERT_NE(p.Find("accel_x"), nullptr);
+  EXPECT_STREQ(p.Find("accel_x")->key->option, "--accel-x");
+  EXPECT_EQ(OptionText(p, *p.Find("accel_y"), "mm"), "2032");  // 80 in/s², a length per s²
+  EXPECT_EQ(p.Find("accel_z"), nullptr);
+  EXPECT_EQ(RefusalOf("accel_z = 0\n"), "m.toml:1:11: key 'accel_z': must be above 0, not 0");
 }
 
 TEST(MachineProfile, WrongTypeIsRefused) {
@@ -233,6 +240,38 @@ TEST(MachineProfile, TheOptionsOwnChecksApplyWithThePosition) {
   EXPECT_NE(step.find("more than 9"), std::string::npos) << step;
   // Given on the command line, the profile's value is not even looked at.
   EXPECT_EQ(ApplyRefusal("dims = 4\n", {"--dims", "2"}), "");
+}
+
+TEST(MachineProfile, StepsPerUnitGiveTheStep) {
+  const MachineProfile mm = ParseMachineProfile("steps_per_mm = [80, 80]\n", "m.toml");
+  EXPECT_EQ(OptionText(mm, *mm.Find("steps_per_mm"), "mm"), "0.0125");
+  // Steps per inch are per inch whatever the profile's units say.
+  const MachineProfile in = ParseMachineProfile("units = \"mm\"\nsteps_per_in = 2000\n", "m.toml");
+  EXPECT_EQ(OptionText(in, *in.Find("steps_per_in"), "in"), "0.0005");
+  EXPECT_EQ(OptionText(in, *in.Find("steps_per_in"), "mm"), "0.0127");
+  Command c;
+  c.Parse({});
+  ApplyMachineProfile(mm, &c.app);
+  EXPECT_EQ(c.step, "0.0125");
+}
+
+TEST(MachineProfile, StepsPerUnitThatDifferOrRepeatTheStepAreRefused) {
+  EXPECT_EQ(RefusalOf("steps_per_mm = [80, 400]\n"),
+            "m.toml:1:16: key 'steps_per_mm': the axes differ (80, 400): fdsurf plans every "
+            "axis on one step, so every axis's steps per unit must be equal (docs/machines.md)");
+  EXPECT_EQ(RefusalOf("step = 0.01\nsteps_per_mm = 80\n"),
+            "m.toml:2:16: key 'steps_per_mm': the step is already given by 'step' on line 1; give "
+            "one of step, steps_per_mm, steps_per_in");
+  EXPECT_EQ(RefusalOf("steps_per_mm = [80]\n"),
+            "m.toml:1:16: key 'steps_per_mm': must be a number, or an array of 2 or 3 numbers "
+            "(one per axis), not array");
+  EXPECT_EQ(RefusalOf("steps_per_mm = -80\n"),
+            "m.toml:1:16: key 'steps_per_mm': must be above 0, not -80");
+  // 1/2032 in is no step of 9 decimals: refused with the figure, not rounded.
+  const std::string inexact = ApplyRefusal("steps_per_in = 2032\n", {"--units", "in"});
+  EXPECT_EQ(inexact.rfind("m.toml:1:16: key 'steps_per_in' (0.000492125984", 0), 0U) << inexact;
+  EXPECT_NE(inexact.find("one step, 1/2032 in, is 0.000492125984"), std::string::npos) << inexact;
+  EXPECT_NE(inexact.find("give 'step' in in"), std::string::npos) << inexact;
 }
 
 TEST(MachineProfile, LengthsAreRefusedWhileTheCommandsUnitsAreUnknown) {

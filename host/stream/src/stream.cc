@@ -97,6 +97,22 @@ void SetServoPulses(const MachineOptions& machine, protocol::MachineConfig* conf
   config->servo_down_us = static_cast<std::uint16_t>(machine.servo_down_us);
 }
 
+// Axis c's acceleration limit in steps/s²: its own, else twice the path's
+// (`accel`, steps/s²); refused unless above the path's, whose excess is
+// what turning may use.
+std::uint32_t AxisAccelSteps(const MachineOptions& machine, double accel, double step,
+                             const std::string& units, int c) {
+  const double given = machine.axis_accel[static_cast<std::size_t>(c)];
+  const double steps = given > 0 ? std::floor(given / step) : 2 * accel;
+  if (!(steps > accel && steps < 4e9)) {
+    throw OptionError(std::string("axis accel ") + "XYZ"[c],
+                      FormatNumber(given > 0 ? given : 2 * machine.accel) + " " + units + "/s²",
+                      "is not above the path's accel (" + FormatNumber(machine.accel) + " " +
+                          units + "/s²): the excess is what turning may use");
+  }
+  return static_cast<std::uint32_t>(steps);
+}
+
 // The machine configuration: travel (the page's unless given), steps per
 // meter, speed and acceleration in steps, the pen delay and servo widths.
 protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath& page,
@@ -146,17 +162,9 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   // Protocol 3 fields: the pen-up speed limit, and each axis's limit, whose
   // excess over the path's acceleration the device leaves for turning.
   config.travel_rate = static_cast<std::uint32_t>(travel_rate);
-  const double axis_accel =
-      machine.axis_accel > 0 ? std::floor(machine.axis_accel / step) : 2 * accel;
-  if (!(axis_accel > accel && axis_accel < 4e9)) {
-    throw OptionError(
-        "axis accel",
-        FormatNumber(machine.axis_accel > 0 ? machine.axis_accel : 2 * machine.accel) + " " +
-            units + "/s²",
-        "is not above the path's accel (" + FormatNumber(machine.accel) + " " + units +
-            "/s²): the excess is what turning may use");
+  for (int c = 0; c < page.dims; ++c) {
+    config.axis_accel[c] = AxisAccelSteps(machine, accel, step, units, c);
   }
-  for (int c = 0; c < page.dims; ++c) config.axis_accel[c] = static_cast<std::uint32_t>(axis_accel);
   SetServoPulses(machine, &config);
   config.flags = machine.homing_required ? protocol::kConfigFlagHomingRequired : 0;
   return config;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "../cli_options.h"
@@ -90,6 +91,7 @@ struct Targets {
     if (flag == "--travel") return "the page";
     if (flag == "--travel-speed") return "--speed";
     if (flag == "--axis-accel") return "twice --accel";
+    if (flag == "--accel-x" || flag == "--accel-y" || flag == "--accel-z") return "--axis-accel";
     if (flag == "--tick-hz") return "the device's";
     return "(built in)";
   }
@@ -113,6 +115,14 @@ std::string ForShow(const std::string& path) {
   return path.rfind(prefix, 0) == 0 ? "~/" + path.substr(prefix.size()) : path;
 }
 
+// The profile's steps_per_mm or steps_per_in, nullptr when it has neither.
+const ProfileValue* StepsPerOf(const MachineProfile& profile) {
+  for (const ProfileValue& value : profile.values) {
+    if (value.key->type == KeyType::kStepsPer) return &value;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
@@ -122,7 +132,8 @@ void AddMachineShowOptions(CLI::App* command, MachineShowOptions* options) {
   const auto& keys = MachineKeys();
   options->values.resize(keys.size());
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (keys[i].option[0] == '\0') continue;
+    // steps_per_mm and steps_per_in feed --step: the profile's keys only.
+    if (keys[i].option[0] == '\0' || keys[i].type == KeyType::kStepsPer) continue;
     if (keys[i].type == KeyType::kBool) {
       command->add_flag(keys[i].option, options->values[i], keys[i].help);
     } else {
@@ -156,6 +167,19 @@ int RunMachineShow(const MachineShowOptions& options) {
     const MachineKey& key = keys[i];
     if (key.option[0] == '\0') continue;
     const ProfileValue* in_profile = profile.Find(key.name);
+    if (key.type == KeyType::kStepsPer) {
+      if (in_profile == nullptr) continue;
+      std::string counts;
+      for (const double n : in_profile->numbers)
+        counts += (counts.empty() ? "" : ",") + FormatNumber(n);
+      std::printf("%-12s %-20s %s %-14s %s\n", key.name, counts.c_str(),
+                  PadTo(key.unit, 10).c_str(), key.option,
+                  ("profile " + ForShow(SourceOf(profile, *in_profile))).c_str());
+      continue;
+    }
+    if (in_profile == nullptr && std::string_view(key.option) == "--step") {
+      in_profile = StepsPerOf(profile);  // the step as steps per unit
+    }
     std::string value;
     std::string source;
     if (!options.values[i].empty()) {
@@ -164,6 +188,7 @@ int RunMachineShow(const MachineShowOptions& options) {
     } else if (in_profile != nullptr) {
       value = OptionText(profile, *in_profile, units);
       source = "profile " + ForShow(SourceOf(profile, *in_profile));
+      if (in_profile->key != &key) source += std::string(" (") + in_profile->key->name + ")";
     } else {
       value = targets.DefaultOf(key.option, units);
       source = "default";

@@ -97,9 +97,9 @@ protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz) {
   const double travel_speed = s.machine.travel_speed > 0 ? s.machine.travel_speed : s.machine.speed;
   const double travel_rate = std::floor(travel_speed / s.step);
   config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
-  const double axis_accel =
-      s.machine.axis_accel > 0 ? std::floor(s.machine.axis_accel / s.step) : 2.0 * config.accel;
   for (int a = 0; a < s.axes; ++a) {
+    const double given = s.machine.axis_accel[static_cast<std::size_t>(a)];
+    const double axis_accel = given > 0 ? std::floor(given / s.step) : 2.0 * config.accel;
     config.axis_accel[a] =
         static_cast<std::uint32_t>(std::clamp(axis_accel, config.accel + 1.0, 4e9));
   }

@@ -26,11 +26,6 @@ struct PlannedKey {
 };
 constexpr PlannedKey kPlannedKeys[] = {
     {"home", "the key is 'homing', a table: [homing] axes, toward, rate, backoff, required"},
-    {"steps_per_mm", "steps per unit are not supported yet: give 'step', the length of one step"},
-    {"steps_per_in", "steps per unit are not supported yet: give 'step', the length of one step"},
-    {"accel_x", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
-    {"accel_y", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
-    {"accel_z", "a limit per axis is not supported yet: give 'axis_accel', one for every axis"},
     {"origin", "the machine's origin is not supported yet (stream --origin places the page)"},
 };
 
@@ -55,6 +50,8 @@ std::string TypeName(KeyType type) {
       return "true or false";
     case KeyType::kTextList:
       return "a string or an array of 1 to 3 strings";
+    case KeyType::kStepsPer:
+      return "a number, or an array of 2 or 3 numbers (one per axis)";
     default:
       return "a number";
   }
@@ -111,6 +108,22 @@ std::string RefusedText(KeyCheck check, const std::string& text) {
   return "";
 }
 
+// Steps per unit, one per axis, must agree: the host plans every axis on
+// one step (the quantum of the drawing, docs/precision.md), so a machine
+// whose axes differ is refused rather than drawn out of scale.
+void CheckOneStep(const MachineKey& key, const ProfileValue& value, const toml::node& node,
+                  const std::string& path) {
+  for (const double n : value.numbers) {
+    if (n == value.numbers.front()) continue;
+    std::string given;
+    for (const double m : value.numbers) given += (given.empty() ? "" : ", ") + FormatNumber(m);
+    throw KeyError(path, node.source(), key.name,
+                   "the axes differ (" + given +
+                       "): fdsurf plans every axis on one step, so every axis's steps per unit "
+                       "must be equal (docs/machines.md)");
+  }
+}
+
 // The value of `key` as the schema says it must be; throws KeyError.
 ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std::string& path) {
   ProfileValue value;
@@ -144,7 +157,12 @@ ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std:
       if (!NumberOf(node, &number)) throw wrong_type();
       value.numbers.push_back(number);
       break;
-    case KeyType::kLengthList: {
+    case KeyType::kLengthList:
+    case KeyType::kStepsPer: {
+      if (key.type == KeyType::kStepsPer && NumberOf(node, &number)) {
+        value.numbers.push_back(number);
+        break;
+      }
       const toml::array* list = node.as_array();
       if (list == nullptr || list->size() < 2 || list->size() > 3) throw wrong_type();
       for (const toml::node& item : *list) {
@@ -154,9 +172,10 @@ ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std:
       break;
     }
   }
+  if (key.type == KeyType::kStepsPer) CheckOneStep(key, value, node, path);
   for (const double n : value.numbers) {
     const bool positive = key.check == KeyCheck::kPositive || key.check == KeyCheck::kQuantum ||
-                          key.type == KeyType::kLengthList;
+                          key.type == KeyType::kLengthList || key.type == KeyType::kStepsPer;
     if (!std::isfinite(n) || (positive && !(n > 0))) {
       throw KeyError(path, node.source(), key.name, "must be above 0, not " + FormatNumber(n));
     }
@@ -253,6 +272,10 @@ const std::vector<MachineKey>& MachineKeys() {
       {"dims", T::kInteger, "", "--dims", C::kNone, "2 (pen plotter) or 3 (with Z, for CNC)"},
       {"step", T::kLength, "units", "--step", C::kQuantum,
        "stream: length of one motor step, every axis"},
+      {"steps_per_mm", T::kStepsPer, "steps/mm", "--step", C::kPositive,
+       "stream: motor steps per mm, every axis or [X, Y, Z] (equal); instead of step"},
+      {"steps_per_in", T::kStepsPer, "steps/in", "--step", C::kPositive,
+       "stream: motor steps per inch, every axis or [X, Y, Z] (equal); instead of step"},
       {"travel", T::kLengthList, "units", "--travel", C::kPositive,
        "stream: machine travel [W, H] or [W, H, D]"},
       {"speed", T::kLength, "units/s", "--speed", C::kPositive,
@@ -263,6 +286,12 @@ const std::vector<MachineKey>& MachineKeys() {
        "stream: path acceleration limit; plot G-code: the time estimate's"},
       {"axis_accel", T::kLength, "units/s²", "--axis-accel", C::kPositive,
        "stream: each axis's acceleration limit, turning included (default: twice accel)"},
+      {"accel_x", T::kLength, "units/s²", "--accel-x", C::kPositive,
+       "stream: the X axis's acceleration limit (default: axis_accel)"},
+      {"accel_y", T::kLength, "units/s²", "--accel-y", C::kPositive,
+       "stream: the Y axis's acceleration limit (default: axis_accel)"},
+      {"accel_z", T::kLength, "units/s²", "--accel-z", C::kPositive,
+       "stream: the Z axis's acceleration limit (default: axis_accel)"},
       {"pen_delay", T::kInteger, "ms", "--pen-delay", C::kNone,
        "stream: rest after each pen change"},
       {"servo_pulse_up", T::kInteger, "µs", "--servo-pulse-up", C::kNone,
@@ -377,6 +406,27 @@ std::string FindMachineProfile(const std::string& name_or_file) {
   return path.string();
 }
 
+namespace {
+
+// step, steps_per_mm and steps_per_in all say the step: one of them only.
+void RefuseTwoSteps(const MachineProfile& profile) {
+  const ProfileValue* first = nullptr;
+  for (const ProfileValue& value : profile.values) {
+    if (std::string_view(value.key->option) != "--step") continue;
+    if (first == nullptr) {
+      first = &value;
+      continue;
+    }
+    throw InputError(profile.path + ":" + std::to_string(value.line) + ":" +
+                     std::to_string(value.column) + ": key '" + value.key->name +
+                     "': the step is already given by '" + first->key->name + "' on line " +
+                     std::to_string(first->line) +
+                     "; give one of step, steps_per_mm, steps_per_in");
+  }
+}
+
+}  // namespace
+
 MachineProfile ParseMachineProfile(std::string_view text, const std::string& path) {
   toml::table table;
   try {
@@ -387,6 +437,7 @@ MachineProfile ParseMachineProfile(std::string_view text, const std::string& pat
   MachineProfile profile;
   profile.path = path;
   ReadTable(table, "", path, &profile);
+  RefuseTwoSteps(profile);
   // toml++ keeps a table's keys sorted; the file's order reads better.
   std::sort(profile.values.begin(), profile.values.end(),
             [](const ProfileValue& a, const ProfileValue& b) { return a.line < b.line; });
@@ -405,6 +456,13 @@ std::string OptionText(const MachineProfile& profile, const ProfileValue& value,
                        const std::string& command_units) {
   const MachineKey& key = *value.key;
   if (!value.text.empty()) return value.text;  // kText, kInteger, kBool, kTextList
+  if (key.type == KeyType::kStepsPer) {
+    // The step, 1/N in the key's own unit, in the command's units; a step
+    // that is no short decimal there is refused by --step's check.
+    const std::string per = std::string(key.name).substr(std::string(key.name).size() - 2);
+    const double step_mm = (per == "in" ? 25.4 : 1.0) / value.numbers.front();
+    return FormatOptionNumber(command_units == "in" ? step_mm / 25.4 : step_mm);
+  }
   double scale = 1;
   if (IsLength(key) && profile.units != command_units)
     scale = profile.units == "in" ? 25.4 : 1 / 25.4;
@@ -456,13 +514,24 @@ void ApplyMachineProfile(const MachineProfile& profile, CLI::App* command) {
       return InputError(message);
     };
     try {
-      if (value.key->check == KeyCheck::kQuantum) (void)Quantum::Parse(text, value.key->option);
+      if (value.key->check == KeyCheck::kQuantum || value.key->type == KeyType::kStepsPer) {
+        (void)Quantum::Parse(text, value.key->option);
+      }
       option->add_result(text);
       option->run_callback();
     } catch (const CLI::ParseError& e) {
       throw refuse(e.what());
     } catch (const InputError& e) {
-      throw refuse(e.what());
+      if (value.key->type != KeyType::kStepsPer) throw refuse(e.what());
+      std::string why = "one step, 1/" + FormatNumber(value.numbers.front()) + " ";
+      why += std::string(value.key->name).substr(10);  // "mm" or "in" of steps_per_
+      why += ", is " + text;
+      why += " " + units;
+      why +=
+          ", not a decimal of at most 9 significant digits and 9 decimals as a step must be "
+          "(docs/precision.md): give 'step' in ";
+      why += units + ", rounded to what your machine's drift allows";
+      throw refuse(why);
     }
   }
 }

@@ -30,6 +30,8 @@ enum class KeyType {
   kLengthList,  // an array of 2 or 3 positive lengths (WxH[xD])
   kBool,        // true or false (a command-line flag)
   kTextList,    // a string, or an array of 1 to 3 strings (one per axis), "A,B,C" as an option
+  kStepsPer,    // motor steps per mm or per inch (the key's own unit): a number for every axis,
+                // or one per axis (equal: the host plans every axis on one step); --step 1/N
 };
 
 /// A further check beyond the type and the option's own (CLI11) check.

@@ -30,6 +30,19 @@ std::string TravelSpeedNote(const StreamOptions& o, const std::string& units) {
   return ", travel " + FormatNumber(o.travel_speed) + " " + units + "/s";
 }
 
+// Each axis's acceleration limit: "4000" when the driven axes share one,
+// else "X 4000, Y 3000".
+std::string AxisAccelText(const std::array<double, 3>& axis_accel, int axes) {
+  bool same = true;
+  for (int a = 1; a < axes; ++a) same = same && axis_accel[a] == axis_accel[0];
+  if (same) return FormatNumber(axis_accel[0]);
+  std::string text;
+  for (int a = 0; a < axes; ++a) {
+    text += std::string(a == 0 ? "" : ", ") + "XYZ"[a] + " " + FormatNumber(axis_accel[a]);
+  }
+  return text;
+}
+
 // The drawn paths as a toolpath on the job's page, for the writers. A point
 // between two unit moves in the same direction lies on the line through its
 // neighbours: leaving it out draws exactly the same path with far fewer
@@ -162,7 +175,7 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   limits.max_rate = job.config.max_rate;
   limits.travel_rate = job.config.travel_rate;
   limits.accel = job.config.accel;
-  limits.axis_accel = job.config.axis_accel[0];
+  for (std::size_t a = 0; a < 3; ++a) limits.axis_accel_each[a] = job.config.axis_accel[a];
   limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
   checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
   checked.bound = job.tolerance_steps + 0.005;
@@ -269,8 +282,9 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                "motion limits (%s %s/s%s, %s %s/s² on the path, %s %s/s² per axis, pen delay %d "
                "ms): %s\n",
                FormatNumber(o.speed).c_str(), units.c_str(), TravelSpeedNote(o, units).c_str(),
-               FormatNumber(o.accel).c_str(), units.c_str(), FormatNumber(o.axis_accel).c_str(),
-               units.c_str(), o.pen_delay_ms, limits.c_str());
+               FormatNumber(o.accel).c_str(), units.c_str(),
+               AxisAccelText(o.axis_accel, job.config.axes).c_str(), units.c_str(), o.pen_delay_ms,
+               limits.c_str());
   if (!o.svg.empty()) std::fprintf(stderr, "wrote %s (svg)\n", o.svg.c_str());
   if (!o.waveform.empty()) std::fprintf(stderr, "wrote %s (waveform)\n", o.waveform.c_str());
   if (!o.png.empty()) {

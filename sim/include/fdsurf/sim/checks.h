@@ -49,6 +49,8 @@ struct MotionLimitsSi {
   /// Acceleration of each axis on its own (the centripetal part on curves
   /// included), steps/s²; 0: measured but not checked.
   double axis_accel = 0;
+  /// The same for one axis (x, y, z), over `axis_accel`; 0: `axis_accel`.
+  std::array<double, 3> axis_accel_each{0, 0, 0};
   double pen_delay_s = 0;
 };
 

@@ -32,10 +32,12 @@ struct MachineOptions {
   /// Path speed and acceleration limits.
   double speed = 100;
   double accel = 2000;
-  /// Each axis's acceleration limit, the centripetal part on curves
-  /// included (CONFIG axis_accel, docs/motion.md "Each axis on curves");
-  /// above `accel`, whose excess is what turning may use; 0: twice `accel`.
-  double axis_accel = 0;
+  /// Each axis's acceleration limit (x, y, z), the centripetal part on
+  /// curves included (CONFIG axis_accel, docs/motion.md "Each axis on
+  /// curves"); above `accel`, whose excess is what turning may use; an
+  /// entry of 0: twice `accel`. The device keeps every axis within the
+  /// smallest of the limits of the axes it drives.
+  std::array<double, 3> axis_accel{0, 0, 0};
   /// Path speed limit with the pen up (the device's CONFIG travel_rate);
   /// 0: the same as `speed`.
   double travel_speed = 0;
