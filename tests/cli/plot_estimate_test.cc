@@ -151,6 +151,30 @@ TEST_F(PlotEstimate, SquareWithJunctionDeviationPassesTheCornersAtGrblsSpeed) {
   EXPECT_NEAR(HeaderSeconds(Slurp(out)), expected, 0.005 + 1e-9);
 }
 
+// Grbl's per-axis limits ($120..$122): a move accelerates at most at
+// min(accel, limit_i / |u_i|). With X held to 50 mm/s² and stops at the
+// corners, the horizontal sides ramp at 50 (20²/50 = 8 mm of ramps: 0.8 s
+// + 32/20 s = 2.4 s), the vertical ones at 100 (2.2 s), and the diagonal
+// travel at 50/cos 45° = 70.7 mm/s² (a triangle, 2·√(L/a) each way).
+TEST_F(PlotEstimate, AnAxisLimitSlowsTheMovesAlongThatAxis) {
+  const std::string out = (dir_ / "square.gcode").string();
+  const RunResult r = Run("plot '" + Square() +
+                          "' --flavor grbl --pen m3 --feed 1200 --travel-rate 3000 --accel 100 "
+                          "--dwell 0.2 --junction-deviation 0 --accel-x 50 -o '" +
+                          out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double diagonal_accel = 50 / std::cos(M_PI / 4);
+  const double travel = 2 * 2 * std::sqrt(std::hypot(10.0, 10.0) / diagonal_accel);
+  const double horizontal = 2 * kFeed / 50 + (kSide - kFeed * kFeed / 50) / kFeed;
+  EXPECT_NEAR(horizontal, 2.4, 1e-12);
+  const double expected = travel + 3 * 0.2 + 2 * horizontal + 2 * Trapezoid(kSide, 0, 0, kFeed);
+  EXPECT_NEAR(expected, 11.589, 0.001);
+  EXPECT_NEAR(HeaderSeconds(Slurp(out)), expected, 0.005 + 1e-9);
+  EXPECT_GT(expected, SquareSeconds(0) + 0.5);  // what the square takes without the limit
+  EXPECT_NE(Slurp(out).find("accel 100 mm/s^2, X 50 mm/s^2 per axis, junction"), std::string::npos);
+  EXPECT_NE(r.err.find("accel 100 mm/s², X 50 mm/s² per axis"), std::string::npos) << r.err;
+}
+
 // The header's lines are comments in both syntaxes: the file reads back as
 // the square alone, and so does what a sender keeps after stripping them.
 TEST_F(PlotEstimate, HeaderIsCommentsThatReaderAndSenderSkip) {

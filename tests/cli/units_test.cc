@@ -33,7 +33,8 @@ const std::map<std::string, std::set<std::string>> kCovered = {
     // PlotOptionsAgreeInBothUnits (and PlotDefaultsAgreeInBothUnits).
     {"plot",
      {"--fit", "--margin", "--tolerance", "--quantum", "--pen-up", "--pen-down", "--feed",
-      "--plunge-feed", "--travel-rate", "--accel", "--junction-deviation"}},
+      "--plunge-feed", "--travel-rate", "--accel", "--accel-x", "--accel-y", "--accel-z",
+      "--junction-deviation"}},
     // render draws with plot's DrawingOptions and PlacePage: the plot cases
     // cover these; RenderDefaultsAgreeInBothUnits checks the defaults.
     {"render", {"--fit", "--margin", "--tolerance", "--quantum"}},
@@ -256,6 +257,9 @@ TEST_F(Units, PlotOptionsAgreeInBothUnits) {
       {"--quantum", "0.00254", "0.0001"},
       {"--accel", "254", "10"},
       {"--junction-deviation", "0.0254", "0.001"},
+      {"--accel-x", "127", "5"},
+      {"--accel-y", "127", "5"},
+      {"--accel-z", "127", "5"},
   };
   for (const Case& c : cases) {
     const Program mm = Plot("mm", std::string(c.option) + " " + c.mm);

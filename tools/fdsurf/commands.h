@@ -6,6 +6,7 @@
 // OutputError and EngineError, which fdsurf.cc reports.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -65,6 +66,9 @@ struct PlotOptions {
   /// converted to --units.
   std::optional<double> accel;
   std::optional<double> junction_deviation;
+  /// --accel-x, --accel-y, --accel-z: each axis's limit in the estimate,
+  /// --units/s² (GcodeOptions::axis_accel); 0 (the default): none.
+  std::array<double, 3> axis_accel{0, 0, 0};
 };
 
 struct PortsOptions {

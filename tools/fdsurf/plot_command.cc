@@ -2,6 +2,7 @@
 // `fdsurf plot` and `fdsurf render`: the patches' isolines as SVG, G-code,
 // HPGL, JSON strokes or a PNG picture.
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cctype>
 #include <cstdio>
 #include <string>
@@ -149,8 +150,18 @@ GcodeOptions GcodeFor(const PlotOptions& o) {
   // junction deviation ($11 = 0.010 mm).
   g.accel = typed_or_default(o.accel, MachineOptions{}.accel);
   g.junction_deviation = typed_or_default(o.junction_deviation, kGrblJunctionDeviationMm);
+  g.axis_accel = o.axis_accel;
   g.estimate_in_header = true;
   return g;
+}
+
+// ", X 500, Y 400 UNITS/s² per axis" for the axes with a limit, else "".
+std::string AxisLimits(const std::array<double, 3>& axis_accel, const char* units) {
+  std::string text;
+  for (std::size_t a = 0; a < 3; ++a) {
+    if (axis_accel[a] > 0) text += std::string(", ") + "XYZ"[a] + " " + FormatNumber(axis_accel[a]);
+  }
+  return text.empty() ? text : text + " " + units + "/s² per axis";
 }
 
 // Counts of the drawing as drawn, before planning joins strokes.
@@ -227,11 +238,12 @@ void PrintGcodeEstimate(const Toolpath& path, const GcodeOptions& g) {
     std::fprintf(stderr, "%s %s\n", extent.c_str(), units);
   }
   std::fprintf(stderr,
-               "estimate: feed %s, plunge %s, G0 %s %s/min; accel %s %s/s², junction deviation "
+               "estimate: feed %s, plunge %s, G0 %s %s/min; accel %s %s/s²%s, junction deviation "
                "%s %s (docs/toolpaths.md, \"Time estimate\")\n",
                FormatNumber(g.feed).c_str(), FormatNumber(g.plunge_feed).c_str(),
                FormatNumber(g.travel_rate).c_str(), units, FormatNumber(g.accel).c_str(), units,
-               FormatNumber(g.junction_deviation).c_str(), units);
+               AxisLimits(g.axis_accel, units).c_str(), FormatNumber(g.junction_deviation).c_str(),
+               units);
 }
 
 // --flavor and the options that only some flavours use (docs/toolpaths.md).
@@ -262,6 +274,15 @@ void AddGcodeFlavorOptions(CLI::App* command, PlotOptions* o) {
                    "acceleration of every move in the time estimate, --units per second² " +
                        DefaultInMmHelp(MachineOptions{}.accel, "mm/s²"))
       ->check(CLI::PositiveNumber);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::string flag = std::string("--accel-") + "xyz"[a];
+    command
+        ->add_option(flag, o->axis_accel[a],
+                     std::string("the ") + "XYZ"[a] +
+                         " axis's acceleration limit in the time estimate (Grbl's $12" + "012"[a] +
+                         "), --units per second² (default: none)")
+        ->check(CLI::PositiveNumber);
+  }
   command
       ->add_option("--junction-deviation", o->junction_deviation,
                    "Grbl's junction deviation in the time estimate, in --units " +

@@ -23,7 +23,22 @@ struct Block {
   double length = 0;  // output units
   Vector unit{};      // direction, length 1
   double rate = 0;    // output units per second
+  double accel = 0;   // output units per second², the axes' limits applied
 };
+
+Vector Minus(const Vector& a, const Vector& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+
+// The acceleration a move in direction `unit` (length 1) may have: the
+// path's, and no axis beyond its own limit (0: none). Grbl's planner
+// (limit_acceleration_by_axis_maximum) limits each block so.
+double AccelAlong(const Vector& unit, double accel, const Vector& axis_accel) {
+  double limit = accel;
+  for (int c = 0; c < 3; ++c) {
+    const double share = std::fabs(unit[c]);
+    if (axis_accel[c] > 0 && share > 1e-12) limit = std::min(limit, axis_accel[c] / share);
+  }
+  return limit;
+}
 
 // The moves between two stops (a dwell, a pen switch, M0, the start and
 // the end), planned as one run: Grbl plans every block in its buffer and
@@ -31,8 +46,8 @@ struct Block {
 // end of the program empties the planner).
 class MotionPlan {
  public:
-  MotionPlan(double accel, double junction_deviation)
-      : accel_(accel), junction_deviation_(junction_deviation) {}
+  MotionPlan(double accel, const Vector& axis_accel, double junction_deviation)
+      : accel_(accel), axis_accel_(axis_accel), junction_deviation_(junction_deviation) {}
 
   // A straight move by `delta` at `rate_per_minute`; zero-length moves are
   // dropped, as Grbl drops them.
@@ -43,6 +58,7 @@ class MotionPlan {
     block.length = length;
     for (int c = 0; c < 3; ++c) block.unit[c] = delta[c] / length;
     block.rate = rate_per_minute / 60;
+    block.accel = AccelAlong(block.unit, accel_, axis_accel_);
     run_.push_back(block);
   }
 
@@ -67,24 +83,35 @@ class MotionPlan {
     std::vector<double> entry(n + 1, 0.0);  // entry[i]: speed² entering block i; entry[n] = 0
     for (std::size_t i = 1; i < n; ++i) {
       const double top = std::min(run_[i - 1].rate, run_[i].rate);
-      entry[i] = std::min(top * top, JunctionSpeedSquared(run_[i - 1].unit, run_[i].unit, accel_,
-                                                          junction_deviation_));
+      entry[i] = std::min(top * top, JunctionSpeedSquared(run_[i - 1].unit, run_[i].unit,
+                                                          JunctionAccel(i), junction_deviation_));
     }
     for (std::size_t i = n; i-- > 0;) {  // backward: able to slow down for what follows
-      entry[i] = std::min(entry[i], entry[i + 1] + 2 * accel_ * run_[i].length);
+      entry[i] = std::min(entry[i], entry[i + 1] + 2 * run_[i].accel * run_[i].length);
     }
     for (std::size_t i = 0; i < n; ++i) {  // forward: able to speed up to it
-      entry[i + 1] = std::min(entry[i + 1], entry[i] + 2 * accel_ * run_[i].length);
+      entry[i + 1] = std::min(entry[i + 1], entry[i] + 2 * run_[i].accel * run_[i].length);
     }
     double t = 0;
     for (std::size_t i = 0; i < n; ++i) {
       t += TrapezoidSeconds(run_[i].length, std::sqrt(entry[i]), std::sqrt(entry[i + 1]),
-                            run_[i].rate, accel_);
+                            run_[i].rate, run_[i].accel);
     }
     return t;
   }
 
+  // The acceleration of the turn from block i - 1 into block i: the axes'
+  // limits along the change of direction, as Grbl's junction_unit_vec.
+  FDSURF_NODISCARD double JunctionAccel(std::size_t i) const {
+    Vector turn = Minus(run_[i].unit, run_[i - 1].unit);
+    const double size = std::hypot(turn[0], turn[1], turn[2]);
+    if (size == 0) return accel_;
+    for (double& c : turn) c /= size;
+    return AccelAlong(turn, accel_, axis_accel_);
+  }
+
   double accel_;
+  Vector axis_accel_;
   double junction_deviation_;
   std::vector<Block> run_;
   double seconds_ = 0;
@@ -98,8 +125,6 @@ void Grow(const Vector& p, int dims, GcodeEstimate* e) {
   e->drew = true;
 }
 
-Vector Minus(const Vector& a, const Vector& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-
 // The program's moves, in the order WriteGcode writes them, fed to `plan`.
 class ProgramWalk {
  public:
@@ -108,7 +133,7 @@ class ProgramWalk {
         options_(options),
         three_d_(path.dims == 3),
         pen_(three_d_ ? "z" : options.pen),
-        plan_(options.accel, options.junction_deviation),
+        plan_(options.accel, options.axis_accel, options.junction_deviation),
         at_{0, 0, options.pen_up_z} {
     if (pen_ != "z" && pen_ != "m3" && pen_ != "servo") {
       throw OptionError("pen", options.pen, "is not one of z, m3, servo");
@@ -190,6 +215,17 @@ std::string Fixed(double v, int decimals) {
   return text;
 }
 
+// ", X 500, Y 400 units/s^2 per axis" for the axes with a limit, else ""
+// (no parentheses: the line is a parenthesis comment in some flavours).
+std::string AxisAccelNote(const Vector& axis_accel, const std::string& units) {
+  std::string note;
+  for (int c = 0; c < 3; ++c) {
+    if (axis_accel[c] <= 0) continue;
+    note += std::string(", ") + "XYZ"[c] + " " + FormatNumber(axis_accel[c]);
+  }
+  return note.empty() ? note : note + " " + units + "/s^2 per axis";
+}
+
 std::string Clock(double seconds) {
   const auto whole = static_cast<long long>(std::llround(std::max(0.0, seconds)));
   char text[48];
@@ -254,8 +290,8 @@ std::vector<std::string> DescribeGcodeEstimate(const GcodeEstimate& e, const Gco
   lines.push_back(
       "estimate assumes: accel " +
       (o.accel > 0 ? FormatNumber(o.accel) + " " + units + "/s^2" : std::string("none")) +
-      ", junction deviation " + FormatNumber(o.junction_deviation) + " " + units + ", dwell " +
-      FormatNumber(o.dwell) + " s");
+      AxisAccelNote(o.axis_accel, units) + ", junction deviation " +
+      FormatNumber(o.junction_deviation) + " " + units + ", dwell " + FormatNumber(o.dwell) + " s");
   return lines;
 }
 

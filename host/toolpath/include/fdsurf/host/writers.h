@@ -63,6 +63,12 @@ struct GcodeOptions {
   /// length / rate), and Grbl's junction deviation, output units.
   double accel = 0;
   double junction_deviation = 0.01;
+  /// Each axis's acceleration limit (x, y, z; Grbl's $120..$122), output
+  /// units/s²; 0: that axis has none. A move accelerates at most at
+  /// min(accel, limit_i / |u_i|) over the axes i of its direction u, as
+  /// Grbl's planner limits it (and its junction speeds by the same rule on
+  /// the junction's direction).
+  std::array<double, 3> axis_accel{0, 0, 0};
   /// Write the estimate's comments in the header for the generic flavour
   /// too (every other flavour always has them; generic, left alone, stays
   /// what fdsurf always wrote). fdsurf plot sets it.
