@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,8 @@ const host::PatchSet& Teapot() {
 
 // The teapot small and quick (it also runs under the sanitizers): 24×18 mm,
 // 3×3 lines a patch, 0.0125 mm steps, 250 mm/s.
-host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250) {
+host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250,
+                               host::MachineOrigin origin = host::MachineOrigin::kBottomLeft) {
   host::ToolpathOptions options;
   options.view = *host::NamedView("iso");
   options.fit = std::array<double, 2>{24, 18};
@@ -42,6 +44,7 @@ host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250) {
   machine.speed = speed;
   machine.accel = accel;
   machine.pen_delay_ms = 5;
+  machine.origin = origin;
   return host::BuildStreamJob(Teapot(), options, machine, "mm");
 }
 
@@ -467,6 +470,60 @@ TEST(SimulatedPlotter, CurvesMovesAndPenCommandsThroughTheLink) {
   EXPECT_LE(comparison.max_gap, 2.0 + 0.01);
   const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
   EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+}
+
+// Every point of `a` has a point of `b` within one step in X and Y.
+bool WithinAStepOf(const std::vector<std::array<std::int64_t, 3>>& a,
+                   const std::vector<std::array<std::int64_t, 3>>& b) {
+  std::set<std::pair<std::int64_t, std::int64_t>> near;
+  for (const auto& p : b) near.emplace(p[0], p[1]);
+  for (const auto& p : a) {
+    bool found = false;
+    for (std::int64_t dx = -1; dx <= 1 && !found; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1 && !found; ++dy)
+        found = near.count({p[0] + dx, p[1] + dy}) != 0;
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
+// A machine whose position 0 is the page's top left (an AxiDraw's home,
+// MachineOrigin::kTopLeft) moves Y mirrored about the page's height, so
+// that the drawing comes out as seen: the points it draws, mirrored back,
+// are the bottom-left machine's within a step (the two round their
+// control points on opposite sides of .5 ties).
+TEST(BuildStreamJob, ATopLeftOriginDrawsThePageMirroredInY) {
+  const host::StreamJob plain = SmallTeapotJob();
+  const host::StreamJob mirrored = SmallTeapotJob(5000, 250, host::MachineOrigin::kTopLeft);
+  EXPECT_EQ(plain.mirror_steps[1], 0);
+  ASSERT_EQ(mirrored.mirror_steps[0], 0);
+  ASSERT_EQ(mirrored.mirror_steps[1], 1440);  // 18 mm of 0.0125 mm steps
+  const Streamed a = Stream(plain, PlotterOptions{});
+  const Streamed b = Stream(mirrored, PlotterOptions{});
+  ASSERT_TRUE(a.result.finished && b.result.finished) << b.result.error;
+  std::vector<std::array<std::int64_t, 3>> plain_points;
+  std::vector<std::array<std::int64_t, 3>> machine_points;
+  std::vector<std::array<std::int64_t, 3>> page_points;
+  for (const DrawnPath& path : a.drawn) {
+    plain_points.insert(plain_points.end(), path.points.begin(), path.points.end());
+  }
+  for (const DrawnPath& path : b.drawn) {
+    for (const auto& p : path.points) {
+      machine_points.push_back(p);
+      page_points.push_back(host::PageSteps(mirrored, p));
+    }
+  }
+  ASSERT_FALSE(plain_points.empty());
+  EXPECT_TRUE(WithinAStepOf(page_points, plain_points));
+  EXPECT_TRUE(WithinAStepOf(plain_points, page_points));
+  // What the machine itself did is the mirror image (the teapot's spout is
+  // not symmetric), so unmirrored the comparison fails.
+  EXPECT_FALSE(WithinAStepOf(machine_points, plain_points));
+  for (const auto& p : machine_points) {
+    ASSERT_GE(p[1], 0);
+    ASSERT_LE(p[1], 1440);
+  }
 }
 
 }  // namespace

@@ -72,6 +72,7 @@ MachineOptions Machine(const StreamOptions& o) {
   m.servo_up_us = o.servo_pulse_up_us;
   m.servo_down_us = o.servo_pulse_down_us;
   m.homing_required = o.require_homing;
+  if (!o.machine_origin.empty()) m.origin = *ParseMachineOrigin(o.machine_origin);
   return m;
 }
 
@@ -182,6 +183,11 @@ void AddMachineOptions(CLI::App* command, StreamOptions* o) {
                             " axis's acceleration limit, --units per second² (default: "
                             "--axis-accel); the device keeps every axis within the smallest");
   }
+  command
+      ->add_option("--machine-origin", o->machine_origin,
+                   "the page's corner at the machine's position 0: bottom-left (default; X right, "
+                   "Y up), top-left (an AxiDraw: Y toward you), bottom-right, top-right")
+      ->check(CLI::IsMember({"bottom-left", "top-left", "bottom-right", "top-right"}));
   command->add_flag("--require-homing", o->require_homing,
                     "the device refuses to move until homed: run `fdsurf machine home` first");
 }

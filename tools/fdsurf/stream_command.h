@@ -61,6 +61,9 @@ struct StreamOptions {
   int servo_pulse_down_us = 0;
   /// --require-homing: CONFIG's homing-required flag (MachineOptions).
   bool require_homing = false;
+  /// --machine-origin: the page corner at the machine's position 0
+  /// (MachineOrigin, stream.h); "" for bottom-left.
+  std::string machine_origin;
   std::uint32_t tick_hz = 0;
   // The link and the simulator.
   std::uint64_t link_bytes_per_second = 1'000'000;

@@ -88,7 +88,14 @@ TEST(MachineProfile, UnknownKeyIsRefusedWithTheNearestKnownOne) {
 TEST(MachineProfile, KeysOfFeaturesToComeSaySo) {
   EXPECT_NE(RefusalOf("home = true\n").find("key 'home': the key is 'homing', a table"),
             std::string::npos);
-  EXPECT_NE(RefusalOf("origin = [0, 0]\n").find("not supported yet"), std::string::npos);
+}
+
+TEST(MachineProfile, OriginIsACornerOfThePage) {
+  const MachineProfile p = ParseMachineProfile("origin = \"top-left\"\n", "m.toml");
+  ASSERT_NE(p.Find("origin"), nullptr);
+  EXPECT_STREQ(p.Find("origin")->key->option, "--machine-origin");
+  EXPECT_EQ(RefusalOf("origin = [0, 0]\n"),
+            "m.toml:1:10: key 'origin': must be a string, not array");
 }
 
 TEST(MachineProfile, AxisLimitsAreKeysOfTheirOwn) {

@@ -519,6 +519,46 @@ void CheckAsTheDeviceWill(const StreamJob& job) {
 
 }  // namespace
 
+namespace {
+
+// A machine whose origin is another corner of the page sees the drawing
+// mirrored in X and/or Y: its map from the file mirrors that axis about the
+// page's width or height rounded up to whole steps (so that whole steps
+// stay whole, and the drawing stays within 0..travel).
+void MirrorForTheOrigin(MachineOrigin origin, StreamJob* job) {
+  const bool mirror[2] = {
+      origin == MachineOrigin::kBottomRight || origin == MachineOrigin::kTopRight,
+      origin == MachineOrigin::kTopLeft || origin == MachineOrigin::kTopRight};
+  const double step = job->page.quantum.value();
+  const double extent[2] = {job->page.width, job->page.height};
+  OutputMap& map = job->page.map;
+  for (int a = 0; a < 2; ++a) {
+    if (!mirror[a]) continue;
+    const auto steps = static_cast<std::int64_t>(std::ceil(extent[a] / step - 1e-9));
+    job->mirror_steps[a] = std::max<std::int64_t>(steps, 1);
+    std::array<double, 3>& axis = a == 0 ? map.view.right : map.view.up;
+    for (double& c : axis) c = -c;
+    map.offset[a] = static_cast<double>(job->mirror_steps[a]) * step - map.offset[a];
+  }
+}
+
+}  // namespace
+
+std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text) {
+  if (text == "bottom-left") return MachineOrigin::kBottomLeft;
+  if (text == "top-left") return MachineOrigin::kTopLeft;
+  if (text == "bottom-right") return MachineOrigin::kBottomRight;
+  if (text == "top-right") return MachineOrigin::kTopRight;
+  return std::nullopt;
+}
+
+std::array<std::int64_t, 3> PageSteps(const StreamJob& job, std::array<std::int64_t, 3> machine) {
+  for (std::size_t a = 0; a < 2; ++a) {
+    if (job.mirror_steps[a] != 0) machine[a] = job.mirror_steps[a] - machine[a];
+  }
+  return machine;
+}
+
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
                          const MachineOptions& machine, const std::string& units) {
   ToolpathOptions t = options;
@@ -529,6 +569,7 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     // The device's axes run from 0: put the bottom of the surface at Z = 0.
     job.page.map.offset[2] += job.page.depth;
   }
+  MirrorForTheOrigin(machine.origin, &job);
   job.config = ConfigFor(machine, job.page, units);
   job.tolerance_steps = t.tolerance / machine.step.value();
   job.tolerance_q8 =

@@ -88,6 +88,7 @@ struct Targets {
     if (flag == "--axes") return "all";
     if (flag == "--toward") return "min";
     if (flag == "--require-homing") return "false";
+    if (flag == "--machine-origin") return "bottom-left";
     if (flag == "--travel") return "the page";
     if (flag == "--travel-speed") return "--speed";
     if (flag == "--axis-accel") return "twice --accel";

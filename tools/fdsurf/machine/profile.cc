@@ -26,7 +26,6 @@ struct PlannedKey {
 };
 constexpr PlannedKey kPlannedKeys[] = {
     {"home", "the key is 'homing', a table: [homing] axes, toward, rate, backoff, required"},
-    {"origin", "the machine's origin is not supported yet (stream --origin places the page)"},
 };
 
 std::string Where(const std::string& path, const toml::source_region& at) {
@@ -292,6 +291,8 @@ const std::vector<MachineKey>& MachineKeys() {
        "stream: the Y axis's acceleration limit (default: axis_accel)"},
       {"accel_z", T::kLength, "units/s²", "--accel-z", C::kPositive,
        "stream: the Z axis's acceleration limit (default: axis_accel)"},
+      {"origin", T::kText, "", "--machine-origin", C::kNone,
+       "stream: the page's corner at position 0: bottom-left, top-left, bottom-right, top-right"},
       {"pen_delay", T::kInteger, "ms", "--pen-delay", C::kNone,
        "stream: rest after each pen change"},
       {"servo_pulse_up", T::kInteger, "µs", "--servo-pulse-up", C::kNone,

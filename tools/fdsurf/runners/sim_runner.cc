@@ -58,7 +58,7 @@ Toolpath DrawnToolpath(const StreamJob& job, const std::vector<sim::DrawnPath>& 
                                     p[k][0] - p[k - 1][0] == p[k + 1][0] - p[k][0] &&
                                     p[k][1] - p[k - 1][1] == p[k + 1][1] - p[k][1] &&
                                     p[k][2] - p[k - 1][2] == p[k + 1][2] - p[k][2];
-      if (!straight_through) stroke.points.push_back(p[k]);
+      if (!straight_through) stroke.points.push_back(PageSteps(job, p[k]));
     }
     drawn.strokes.push_back(std::move(stroke));
   }
@@ -320,7 +320,7 @@ struct DryRunFigures {
   bool drew = false;
 };
 
-DryRunFigures MeasureDryRun(const sim::SimulatedPlotter& plotter,
+DryRunFigures MeasureDryRun(const StreamJob& job, const sim::SimulatedPlotter& plotter,
                             const std::vector<sim::DrawnPath>& drawn) {
   DryRunFigures f;
   double total = 0;
@@ -332,9 +332,10 @@ DryRunFigures MeasureDryRun(const sim::SimulatedPlotter& plotter,
   for (const sim::DrawnPath& path : drawn) {
     for (std::size_t k = 0; k < path.points.size(); ++k) {
       const auto& p = path.points[k];
+      const std::array<std::int64_t, 3> on_page = PageSteps(job, p);
       for (int c = 0; c < 3; ++c) {
-        f.lo[c] = f.drew ? std::min(f.lo[c], p[c]) : p[c];
-        f.hi[c] = f.drew ? std::max(f.hi[c], p[c]) : p[c];
+        f.lo[c] = f.drew ? std::min(f.lo[c], on_page[c]) : on_page[c];
+        f.hi[c] = f.drew ? std::max(f.hi[c], on_page[c]) : on_page[c];
       }
       f.drew = true;
       if (k == 0) continue;
@@ -405,7 +406,7 @@ int RunDryRun(const StreamOptions& o, const StreamJob& job) {
   if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
   const std::vector<sim::DrawnPath> drawn = plotter.DrawnPaths();
   WriteDrawing(o, job, plotter, drawn);
-  PrintDryRun(o, job, tick_hz, MeasureDryRun(plotter, drawn));
+  PrintDryRun(o, job, tick_hz, MeasureDryRun(job, plotter, drawn));
   return 0;
 }
 

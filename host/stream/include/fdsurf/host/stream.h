@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,16 @@
 #include "fdsurf/protocol/messages.h"
 
 namespace fdsurf::host {
+
+/// Which corner of the page the machine's position 0 is at, seen as the
+/// drawing is seen: the page's own origin (bottom left, X right and Y up,
+/// Grbl's and most CNCs'), or another corner, toward which that axis's
+/// position then decreases (top left: an AxiDraw's home, Y toward the user).
+enum class MachineOrigin { kBottomLeft, kTopLeft, kBottomRight, kTopRight };
+
+/// "bottom-left", "top-left", "bottom-right", "top-right": the origin; nullopt
+/// for another text.
+std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text);
 
 /// The machine, in output units (mm or in) and seconds. The defaults are in
 /// mm (mm/s, mm/s²); a caller working in inches converts them (fdsurf stream
@@ -50,6 +61,9 @@ struct MachineOptions {
   /// CONFIG's kConfigFlagHomingRequired: the device refuses motion
   /// (kNotHomed) until every axis has been homed (`fdsurf machine home`).
   bool homing_required = false;
+  /// Where position 0 is on the page; the job mirrors X and/or Y so that
+  /// the drawing comes out as seen (StreamJob::mirror_steps).
+  MachineOrigin origin = MachineOrigin::kBottomLeft;
 };
 
 /// One patch as the device will draw it, for checks: the patch, and the
@@ -92,7 +106,16 @@ struct StreamJob {
   /// Edge lines left out because a patch earlier in the order draws the
   /// same curve (PatchCommand::skip_lines).
   std::size_t shared_edges_skipped = 0;
+  /// For X and Y, 0 when the machine's axis runs as the page's; else the
+  /// axis is mirrored (MachineOptions::origin): the machine's position is
+  /// mirror_steps[a] minus the page's, both in whole steps (the page's
+  /// width or height rounded up to a whole step).
+  std::array<std::int64_t, 2> mirror_steps{0, 0};
 };
+
+/// A point the machine drew (steps, its own axes) on the page (steps from
+/// the page's origin): the identity unless the job mirrors an axis.
+std::array<std::int64_t, 3> PageSteps(const StreamJob& job, std::array<std::int64_t, 3> machine);
 
 /// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
 /// tolerance, dims; the quantum is replaced by machine.step). The plan
