@@ -107,6 +107,35 @@ TEST_F(MachineCli, StepsPerMmAndAxisLimitsAreTheFlagsOfTheSameName) {
   EXPECT_NE(Slurp(c), Slurp(b));
 }
 
+// steps_per_mm = [80, 100]: each axis in its own steps. The dry run's page
+// extent is the one-step machine's, the manual commands count each axis in
+// its own steps, and a --step list that is not one is refused.
+TEST_F(MachineCli, StepsPerMmPerAxisDriveEachAxisInItsOwnSteps) {
+  const std::string axes =
+      Write("axes.toml", "device = \"sim\"\nsteps_per_mm = [80, 100]\ntravel = [300, 200]\n");
+  const std::string one = Write("one.toml", "device = \"sim\"\nsteps_per_mm = 80\n");
+  const std::string drawing = "stream '" + kTeapot + "' --fit 120x80 --lines 2 --dry-run ";
+  const RunResult per_axis = Run(drawing + "--machine '" + axes + "'");
+  const RunResult uniform = Run(drawing + "--machine '" + one + "'");
+  ASSERT_EQ(per_axis.exit_code, 0) << per_axis.err;
+  ASSERT_EQ(uniform.exit_code, 0) << uniform.err;
+  const auto extent = [](const std::string& out) {
+    const std::size_t at = out.find("page extent drawn:");
+    return out.substr(at, out.find('\n', at) - at);
+  };
+  EXPECT_EQ(extent(per_axis.out), extent(uniform.out));
+  const RunResult where = Run("machine goto 100 50 --machine '" + axes + "' -q");
+  ASSERT_EQ(where.exit_code, 0) << where.err;
+  EXPECT_EQ(where.out,
+            "position x 100, y 50 mm (steps 8000, 5000); pen up; motors on; homed none; "
+            "endstops triggered none\n");
+  const RunResult bad = Run("stream '" + kTeapot + "' --step 0.0125,0.01,0.0025,1");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--step: '0.0125,0.01,0.0025,1' is not S or SX,SY[,SZ]"),
+            std::string::npos)
+      << bad.err;
+}
+
 TEST_F(MachineCli, CommandLineBeatsTheProfile) {
   const RunResult r = Run("stream '" + kTeapot + "' --fit 240x160 --lines 2 --machine '" +
                           kMachines + "/sim.toml' --speed 60 --pen-delay 20");

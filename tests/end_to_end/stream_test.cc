@@ -31,7 +31,8 @@ const host::PatchSet& Teapot() {
 // The teapot small and quick (it also runs under the sanitizers): 24×18 mm,
 // 3×3 lines a patch, 0.0125 mm steps, 250 mm/s.
 host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250,
-                               host::MachineOrigin origin = host::MachineOrigin::kBottomLeft) {
+                               host::MachineOrigin origin = host::MachineOrigin::kBottomLeft,
+                               const char* y_step = nullptr) {
   host::ToolpathOptions options;
   options.view = *host::NamedView("iso");
   options.fit = std::array<double, 2>{24, 18};
@@ -45,6 +46,7 @@ host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250,
   machine.accel = accel;
   machine.pen_delay_ms = 5;
   machine.origin = origin;
+  if (y_step != nullptr) machine.own_step[1] = host::Quantum::Parse(y_step);
   return host::BuildStreamJob(Teapot(), options, machine, "mm");
 }
 
@@ -524,6 +526,70 @@ TEST(BuildStreamJob, ATopLeftOriginDrawsThePageMirroredInY) {
     ASSERT_GE(p[1], 0);
     ASSERT_LE(p[1], 1440);
   }
+}
+
+// Every point of `a` (mm) lies within `d` mm in X and Y of a point of `b`,
+// whose points are whole multiples of `b_step` mm.
+bool NearInMm(const std::vector<std::array<double, 2>>& a,
+              const std::vector<std::array<double, 2>>& b, double b_step, double d) {
+  std::set<std::pair<std::int64_t, std::int64_t>> grid;
+  for (const auto& p : b) {
+    grid.emplace(std::llround(p[0] / b_step), std::llround(p[1] / b_step));
+  }
+  const auto reach = static_cast<std::int64_t>(std::ceil(d / b_step));
+  for (const auto& p : a) {
+    const std::int64_t x = std::llround(p[0] / b_step);
+    const std::int64_t y = std::llround(p[1] / b_step);
+    bool found = false;
+    for (std::int64_t dx = -reach; dx <= reach && !found; ++dx) {
+      for (std::int64_t dy = -reach; dy <= reach && !found; ++dy) {
+        found = grid.count({x + dx, y + dy}) != 0 && std::fabs((x + dx) * b_step - p[0]) <= d &&
+                std::fabs((y + dy) * b_step - p[1]) <= d;
+      }
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
+// A machine whose Y steps 0.01 mm under X's 0.0125 mm (steps_per_mm = [80,
+// 100]): the device gets Y in its own steps, and what it draws, in mm, is
+// the drawing of a machine with one step for both, within 0.03 mm (both
+// are within 0.71 steps of the exact curves, and points lie a step apart).
+TEST(BuildStreamJob, EachAxisInItsOwnStepsDrawsTheSameDrawing) {
+  const host::StreamJob plain = SmallTeapotJob();
+  const host::StreamJob fine_y =
+      SmallTeapotJob(5000, 250, host::MachineOrigin::kBottomLeft, "0.01");
+  EXPECT_EQ(fine_y.config.steps_per_meter[0], 80000u);
+  EXPECT_EQ(fine_y.config.steps_per_meter[1], 100000u);
+  EXPECT_EQ(fine_y.config.travel_steps[1], 1800);  // 18 mm
+  // Path limits in X's (the coarser) steps: no direction is faster in mm.
+  EXPECT_EQ(fine_y.config.max_rate, plain.config.max_rate);
+  EXPECT_EQ(host::PageQuantum(fine_y).Format(1), "0.0025");
+  const Streamed a = Stream(plain, PlotterOptions{});
+  const Streamed b = Stream(fine_y, PlotterOptions{});
+  ASSERT_TRUE(a.result.finished && b.result.finished) << b.result.error;
+  std::vector<std::array<double, 2>> plain_mm;
+  std::vector<std::array<double, 2>> fine_mm;
+  std::vector<std::array<double, 2>> one_step_read;  // fine_y's steps read as X's
+  for (const DrawnPath& path : a.drawn) {
+    for (const auto& p : path.points) plain_mm.push_back({p[0] * 0.0125, p[1] * 0.0125});
+  }
+  for (const DrawnPath& path : b.drawn) {
+    for (const auto& p : path.points) {
+      const auto q = host::PagePosition(fine_y, p);
+      fine_mm.push_back({q[0] * 0.0025, q[1] * 0.0025});
+      one_step_read.push_back({p[0] * 0.0125, p[1] * 0.0125});
+    }
+  }
+  EXPECT_TRUE(NearInMm(fine_mm, plain_mm, 0.0125, 0.03));
+  EXPECT_TRUE(NearInMm(plain_mm, fine_mm, 0.0025, 0.03));
+  // The device's Y really is in 0.01 mm steps: read as 0.0125 mm it is 25 %
+  // taller than the drawing.
+  EXPECT_FALSE(NearInMm(one_step_read, plain_mm, 0.0125, 0.03));
+  // And every axis kept its own limits in its own steps.
+  const MotionReport motion = CheckMotion(b.steps, b.pens, LimitsOf(fine_y));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
 }
 
 }  // namespace

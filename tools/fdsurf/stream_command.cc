@@ -4,8 +4,10 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "cli_options.h"
 #include "fdsurf/host/hidden_lines.h"
@@ -41,9 +43,30 @@ ToolpathOptions DrawingOptions(const StreamOptions& o) {
   return t;
 }
 
+// --step S (every axis) or SX,SY[,SZ] (each axis its own; an axis left
+// out takes X's).
+void SetSteps(const std::string& text, MachineOptions* m) {
+  std::vector<std::string> items;
+  std::stringstream list(text);
+  for (std::string item; std::getline(list, item, ',');) items.push_back(item);
+  if (items.empty() || items.size() > 3 || text.back() == ',') {
+    throw InputError("--step: '" + text + "' is not S or SX,SY[,SZ]");
+  }
+  static const char* const kWhat[3] = {"--step (X)", "--step (Y)", "--step (Z)"};
+  m->step = Quantum::Parse(items[0], items.size() == 1 ? "--step" : kWhat[0]);
+  for (std::size_t a = 1; a < items.size(); ++a) {
+    const Quantum own = Quantum::Parse(items[a], kWhat[a]);
+    if (own.value() != m->step.value()) m->own_step[a] = own;
+  }
+}
+
 MachineOptions Machine(const StreamOptions& o) {
   MachineOptions m;  // the defaults, in mm, mm/s and mm/s²
-  m.step = o.step.empty() ? DefaultStepIn(m.step, o.units) : Quantum::Parse(o.step, "--step");
+  if (o.step.empty()) {
+    m.step = DefaultStepIn(m.step, o.units);
+  } else {
+    SetSteps(o.step, &m);
+  }
   if (!o.travel.empty()) {
     const std::size_t x1 = o.travel.find('x');
     const std::size_t x2 = x1 == std::string::npos ? x1 : o.travel.find('x', x1 + 1);
@@ -162,8 +185,10 @@ int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptio
 void AddMachineOptions(CLI::App* command, StreamOptions* o) {
   const MachineOptions mm;  // the defaults, in mm, mm/s and mm/s²
   command->add_option("--step", o->step,
-                      "length of one motor step, in --units (default " + mm.step.Format(1) +
-                          " mm; for --units in " + DefaultStepIn(mm.step, "in").Format(1) +
+                      "length of one motor step, in --units, S or one per axis SX,SY[,SZ] "
+                      "(default " +
+                          mm.step.Format(1) + " mm; for --units in " +
+                          DefaultStepIn(mm.step, "in").Format(1) +
                           " in, the nearest with 9 decimals)");
   command->add_option("--travel", o->travel,
                       "machine travel WxH[xD] in --units (default: the page)");

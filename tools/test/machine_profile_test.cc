@@ -250,8 +250,11 @@ TEST(MachineProfile, TheOptionsOwnChecksApplyWithThePosition) {
 }
 
 TEST(MachineProfile, StepsPerUnitGiveTheStep) {
-  const MachineProfile mm = ParseMachineProfile("steps_per_mm = [80, 80]\n", "m.toml");
+  const MachineProfile mm = ParseMachineProfile("steps_per_mm = 80\n", "m.toml");
   EXPECT_EQ(OptionText(mm, *mm.Find("steps_per_mm"), "mm"), "0.0125");
+  // One per axis: --step SX,SY,SZ (a leadscrew Z of 400 steps/mm).
+  const MachineProfile axes = ParseMachineProfile("steps_per_mm = [80, 100, 400]\n", "m.toml");
+  EXPECT_EQ(OptionText(axes, *axes.Find("steps_per_mm"), "mm"), "0.0125,0.01,0.0025");
   // Steps per inch are per inch whatever the profile's units say.
   const MachineProfile in = ParseMachineProfile("units = \"mm\"\nsteps_per_in = 2000\n", "m.toml");
   EXPECT_EQ(OptionText(in, *in.Find("steps_per_in"), "in"), "0.0005");
@@ -262,10 +265,7 @@ TEST(MachineProfile, StepsPerUnitGiveTheStep) {
   EXPECT_EQ(c.step, "0.0125");
 }
 
-TEST(MachineProfile, StepsPerUnitThatDifferOrRepeatTheStepAreRefused) {
-  EXPECT_EQ(RefusalOf("steps_per_mm = [80, 400]\n"),
-            "m.toml:1:16: key 'steps_per_mm': the axes differ (80, 400): fdsurf plans every "
-            "axis on one step, so every axis's steps per unit must be equal (docs/machines.md)");
+TEST(MachineProfile, StepsPerUnitThatRepeatTheStepOrAreNoDecimalAreRefused) {
   EXPECT_EQ(RefusalOf("step = 0.01\nsteps_per_mm = 80\n"),
             "m.toml:2:16: key 'steps_per_mm': the step is already given by 'step' on line 1; give "
             "one of step, steps_per_mm, steps_per_in");
@@ -277,7 +277,8 @@ TEST(MachineProfile, StepsPerUnitThatDifferOrRepeatTheStepAreRefused) {
   // 1/2032 in is no step of 9 decimals: refused with the figure, not rounded.
   const std::string inexact = ApplyRefusal("steps_per_in = 2032\n", {"--units", "in"});
   EXPECT_EQ(inexact.rfind("m.toml:1:16: key 'steps_per_in' (0.000492125984", 0), 0U) << inexact;
-  EXPECT_NE(inexact.find("one step, 1/2032 in, is 0.000492125984"), std::string::npos) << inexact;
+  EXPECT_NE(inexact.find("a step of 1/N in for N = 2032 (0.000492125984"), std::string::npos)
+      << inexact;
   EXPECT_NE(inexact.find("give 'step' in in"), std::string::npos) << inexact;
 }
 

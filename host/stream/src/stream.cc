@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -23,11 +24,10 @@ namespace {
 
 using Vec = std::array<double, 3>;
 
-// A point of the file in steps, through the job's map.
+// A point of the file in steps, each axis in its own, through the job's map.
 Vec ToSteps(const Point3& model, const StreamJob& job) {
   Vec out = job.page.map.Apply(model);
-  const double step = job.page.quantum.value();
-  for (double& c : out) c /= step;
+  for (std::size_t c = 0; c < 3; ++c) out[c] /= job.steps[c].value();
   if (job.page.dims == 2) out[2] = 0;
   return out;
 }
@@ -119,21 +119,25 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
                                   const std::string& units) {
   protocol::MachineConfig config{};
   config.axes = static_cast<std::uint8_t>(page.dims);
-  const double step = machine.step.value();
+  // The device measures its path in steps: the limits in steps of the
+  // coarsest axis hold along every direction (docs/machines.md).
+  const double step = machine.CoarsestStep(page.dims);
   const double extent[3] = {page.width, page.height, page.depth};
   const char* const fields[3] = {"travel X", "travel Y", "travel Z"};
   for (int c = 0; c < 3; ++c) {
     config.steps_per_meter[c] = 0;
     config.travel_steps[c] = 0;
     if (c >= page.dims) continue;
-    const double travel = machine.travel[c] > 0 ? machine.travel[c] : std::max(extent[c], step);
+    const Quantum& axis_step = machine.StepOf(c);
+    const double travel =
+        machine.travel[c] > 0 ? machine.travel[c] : std::max(extent[c], axis_step.value());
     if (travel < extent[c] - 1e-9) {
       throw OptionError(fields[c], FormatNumber(travel) + " " + units,
                         "is smaller than the page (" + FormatNumber(extent[c]) + " " + units + ")");
     }
-    config.travel_steps[c] = TravelSteps(travel, machine.step, units, fields[c],
+    config.travel_steps[c] = TravelSteps(travel, axis_step, units, fields[c],
                                          /*round_up=*/!(machine.travel[c] > 0));
-    const double meters = step * (units == "in" ? 0.0254 : 0.001);
+    const double meters = axis_step.value() * (units == "in" ? 0.0254 : 0.001);
     config.steps_per_meter[c] = static_cast<std::uint32_t>(std::lround(1 / meters));
   }
   const double max_rate = std::floor(machine.speed / step);
@@ -163,7 +167,7 @@ protocol::MachineConfig ConfigFor(const MachineOptions& machine, const Toolpath&
   // excess over the path's acceleration the device leaves for turning.
   config.travel_rate = static_cast<std::uint32_t>(travel_rate);
   for (int c = 0; c < page.dims; ++c) {
-    config.axis_accel[c] = AxisAccelSteps(machine, accel, step, units, c);
+    config.axis_accel[c] = AxisAccelSteps(machine, accel, machine.StepOf(c).value(), units, c);
   }
   SetServoPulses(machine, &config);
   config.flags = machine.homing_required ? protocol::kConfigFlagHomingRequired : 0;
@@ -185,7 +189,7 @@ protocol::Command PatchCommandFor(const Patch& patch, const ToolpathOptions& t,
   body.lines_t = static_cast<std::uint16_t>(t.lines_t);
   body.tolerance_q8 = job->tolerance_q8;
   for (auto& axis : body.geometry) axis = PatchGeometry1{};
-  PatchToQuanta(patch, job->page.map, machine.step, t.dims, body.geometry);
+  PatchToQuanta(patch, job->page.map, job->steps, t.dims, body.geometry);
   body.skip_lines = 0;
   struct Edge {
     IsolineFamily family;
@@ -241,8 +245,7 @@ struct DeviceCurve {
   std::array<std::int32_t, 3> end{};
 };
 
-DeviceCurve ToDevice(const Curve& curve, const ToolpathOptions& t, const MachineOptions& machine,
-                     const StreamJob& job) {
+DeviceCurve ToDevice(const Curve& curve, const ToolpathOptions& t, const StreamJob& job) {
   DeviceCurve out;
   protocol::Command& command = out.command;
   command.type = protocol::MessageType::kCurve;
@@ -252,7 +255,7 @@ DeviceCurve ToDevice(const Curve& curve, const ToolpathOptions& t, const Machine
   body.dims = static_cast<std::uint8_t>(t.dims);
   body.tolerance_q8 = job.tolerance_q8;
   for (auto& axis : body.geometry) axis = CurveGeometry1{};
-  CurveToQuanta(curve, job.page.map, machine.step, t.dims, body.geometry);
+  CurveToQuanta(curve, job.page.map, job.steps, t.dims, body.geometry);
   PowerCurve1 power[protocol::kMaxAxes];
   const Status status = CurvePowerCoefficients(body.geometry, curve.basis, power);
   if (status != Status::kOk) {
@@ -374,13 +377,12 @@ class CurveEmitter {
 // recorded in job->layers when the file has layers), within a layer in the
 // order of OrderLayer. A pen-up move only where a curve does not start where
 // the one before ended (so a chain is drawn in one stroke).
-void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const MachineOptions& machine,
-                      StreamJob* job) {
+void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, StreamJob* job) {
   std::vector<DeviceCurve> device;
   device.reserve(set.curves.size());
   std::map<int, std::vector<std::size_t>> by_layer;
   for (std::size_t c = 0; c < set.curves.size(); ++c) {
-    device.push_back(ToDevice(set.curves[c], t, machine, *job));
+    device.push_back(ToDevice(set.curves[c], t, *job));
     by_layer[set.layers.empty() ? 0 : set.curves[c].layer].push_back(c);
   }
   CurveEmitter emit(job);
@@ -396,7 +398,7 @@ void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, const Machi
     for (const CurveVisit& visit :
          OrderLayer(curves, device, set.keep_order, reversible, emit.At())) {
       const Curve& curve = set.curves[visit.curve];
-      emit.Draw(visit.reversed ? ToDevice(Reversed(curve), t, machine, *job) : device[visit.curve],
+      emit.Draw(visit.reversed ? ToDevice(Reversed(curve), t, *job) : device[visit.curve],
                 curve.straight, visit.curve, curve.origin);
     }
   }
@@ -467,7 +469,6 @@ template <int kDims>
 [[noreturn]] void ThrowRefusal(const StreamJob& job, std::size_t index, protocol::ErrorCode error,
                                std::uint8_t detail) {
   const protocol::Command& command = job.commands[index];
-  const double step = job.page.quantum.value();
   const std::string units = " " + job.page.units;
   std::string message = job.labels[index] + ": ";
   if (error == protocol::ErrorCode::kPlannerRefused) {
@@ -481,6 +482,7 @@ template <int kDims>
     throw EngineError(message);
   }
   const int axis = detail & 3;
+  const double step = job.steps[static_cast<std::size_t>(axis)].value();
   const std::string travel =
       "the travel 0.." + FormatNumber(job.config.travel_steps[axis] * step) + units;
   if (command.type == protocol::MessageType::kMove) {
@@ -529,11 +531,11 @@ void MirrorForTheOrigin(MachineOrigin origin, StreamJob* job) {
   const bool mirror[2] = {
       origin == MachineOrigin::kBottomRight || origin == MachineOrigin::kTopRight,
       origin == MachineOrigin::kTopLeft || origin == MachineOrigin::kTopRight};
-  const double step = job->page.quantum.value();
   const double extent[2] = {job->page.width, job->page.height};
   OutputMap& map = job->page.map;
   for (int a = 0; a < 2; ++a) {
     if (!mirror[a]) continue;
+    const double step = job->steps[static_cast<std::size_t>(a)].value();
     const auto steps = static_cast<std::int64_t>(std::ceil(extent[a] / step - 1e-9));
     job->mirror_steps[a] = std::max<std::int64_t>(steps, 1);
     std::array<double, 3>& axis = a == 0 ? map.view.right : map.view.up;
@@ -552,6 +554,52 @@ std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text) {
   return std::nullopt;
 }
 
+namespace {
+
+// `quantum` as a multiple of the decimal 10^-decimals (decimals at least
+// the quantum's own).
+std::int64_t MantissaAt(const Quantum& quantum, int decimals) {
+  std::int64_t mantissa = quantum.mantissa();
+  for (int d = quantum.decimals(); d < decimals; ++d) mantissa *= 10;
+  return mantissa;
+}
+
+}  // namespace
+
+Quantum PageQuantum(const StreamJob& job) {
+  const int dims = job.page.dims;
+  int decimals = 0;
+  for (int a = 0; a < dims; ++a) {
+    decimals = std::max(decimals, job.steps[static_cast<std::size_t>(a)].decimals());
+  }
+  std::int64_t common = 0;
+  for (int a = 0; a < dims; ++a) {
+    common = std::gcd(common, MantissaAt(job.steps[static_cast<std::size_t>(a)], decimals));
+  }
+  if (common == MantissaAt(job.steps[0], decimals)) return job.steps[0];
+  // common · 10^-decimals as text: at most 9 significant digits, since it
+  // divides a step's mantissa.
+  std::string digits = std::to_string(common);
+  if (decimals > 0) {
+    if (static_cast<int>(digits.size()) <= decimals) {
+      digits.insert(0, static_cast<std::size_t>(decimals + 1) - digits.size(), '0');
+    }
+    digits.insert(digits.size() - static_cast<std::size_t>(decimals), ".");
+  }
+  return Quantum::Parse(digits, "the drawing's quantum");
+}
+
+std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
+                                         const std::array<std::int64_t, 3>& machine) {
+  const Quantum page = PageQuantum(job);
+  std::array<std::int64_t, 3> out = PageSteps(job, machine);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const int decimals = std::max(page.decimals(), job.steps[a].decimals());
+    out[a] *= MantissaAt(job.steps[a], decimals) / MantissaAt(page, decimals);
+  }
+  return out;
+}
+
 std::array<std::int64_t, 3> PageSteps(const StreamJob& job, std::array<std::int64_t, 3> machine) {
   for (std::size_t a = 0; a < 2; ++a) {
     if (job.mirror_steps[a] != 0) machine[a] = job.mirror_steps[a] - machine[a];
@@ -565,13 +613,14 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   t.quantum = machine.step;
   StreamJob job;
   job.page = PlanPage(set, t, units);
+  for (int a = 0; a < 3; ++a) job.steps[static_cast<std::size_t>(a)] = machine.StepOf(a);
   if (t.dims == 3) {
     // The device's axes run from 0: put the bottom of the surface at Z = 0.
     job.page.map.offset[2] += job.page.depth;
   }
   MirrorForTheOrigin(machine.origin, &job);
   job.config = ConfigFor(machine, job.page, units);
-  job.tolerance_steps = t.tolerance / machine.step.value();
+  job.tolerance_steps = t.tolerance / machine.CoarsestStep(t.dims);
   job.tolerance_q8 =
       static_cast<std::uint32_t>(std::min(std::floor(job.tolerance_steps * 256), 4294967295.0));
 
@@ -594,7 +643,7 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
     job.labels.push_back("patch " + std::to_string(visit.index) + " (" + patch.origin + ")");
     job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
   }
-  AddCurveCommands(set, t, machine, &job);
+  AddCurveCommands(set, t, &job);
   if (t.dims == 3) {
     CheckAsTheDeviceWill<3>(job);
   } else {
@@ -693,7 +742,7 @@ VisibleCurves VisibleCurvesOf(const PatchSet& set, const ToolpathOptions& option
     const double pieces_depth = PlanPage(out.set, out.options, units).depth;
     out.set.curves = CurvesOfStrokes(set, path, path.depth - pieces_depth);
     if (out.machine.travel[2] <= 0) {
-      out.machine.travel[2] = std::max(path.depth, machine.step.value());
+      out.machine.travel[2] = std::max(path.depth, machine.StepOf(2).value());
     }
   }
   return out;

@@ -304,23 +304,36 @@ GeometryFixed OutputGeometry(double value, const Quantum& quantum, const std::st
 
 void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quantum, int dims,
                    PatchGeometry1* geometry) {
+  PatchToQuanta(patch, map, {quantum, quantum, quantum}, dims, geometry);
+}
+
+void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
+                   CurveGeometry1* geometry) {
+  CurveToQuanta(curve, map, {quantum, quantum, quantum}, dims, geometry);
+}
+
+void PatchToQuanta(const Patch& patch, const OutputMap& map, const std::array<Quantum, 3>& quanta,
+                   int dims, PatchGeometry1* geometry) {
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
       const auto out =
           IsPoint(patch.basis, i, j) ? map.Apply(patch.g[i][j]) : map.ApplyLinear(patch.g[i][j]);
       for (int c = 0; c < dims; ++c) {
-        geometry[c].g[i][j] = OutputGeometry(out[c], quantum, patch.origin);
+        geometry[c].g[i][j] =
+            OutputGeometry(out[c], quanta[static_cast<std::size_t>(c)], patch.origin);
       }
     }
   }
 }
 
-void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
-                   CurveGeometry1* geometry) {
+void CurveToQuanta(const Curve& curve, const OutputMap& map, const std::array<Quantum, 3>& quanta,
+                   int dims, CurveGeometry1* geometry) {
   for (int k = 0; k < 4; ++k) {
     const auto out =
         IsCurvePoint(curve.basis, k) ? map.Apply(curve.g[k]) : map.ApplyLinear(curve.g[k]);
-    for (int c = 0; c < dims; ++c) geometry[c].g[k] = OutputGeometry(out[c], quantum, curve.origin);
+    for (int c = 0; c < dims; ++c) {
+      geometry[c].g[k] = OutputGeometry(out[c], quanta[static_cast<std::size_t>(c)], curve.origin);
+    }
   }
 }
 

@@ -35,8 +35,9 @@ struct Settings {
   StreamOptions stream;
   MachineOptions machine;
   int axes = 2;
-  double step = 0;         // in stream.units
-  MachineProfile profile;  // --machine's (no values without it)
+  std::array<double, 3> step{};  // each axis's, in stream.units
+  double coarsest_step = 0;      // the longest of the driven axes'
+  MachineProfile profile;        // --machine's (no values without it)
 };
 
 void GiveOption(CLI::App* command, const std::string& flag, const std::string& value) {
@@ -72,7 +73,8 @@ Settings Resolve(const ManualOptions& o) {
         "(--machine) or --travel WxH on the command line");
   }
   s.axes = s.machine.travel[2] > 0 ? 3 : 2;
-  s.step = s.machine.step.value();
+  for (int a = 0; a < 3; ++a) s.step[static_cast<std::size_t>(a)] = s.machine.StepOf(a).value();
+  s.coarsest_step = s.machine.CoarsestStep(s.axes);
   return s;
 }
 
@@ -83,23 +85,27 @@ std::int32_t ToSteps(double length, double step) {
 protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz) {
   protocol::MachineConfig config{};
   config.axes = static_cast<std::uint8_t>(s.axes);
-  const double meters = s.step * (s.stream.units == "in" ? 0.0254 : 0.001);
   for (int a = 0; a < s.axes; ++a) {
+    const double step = s.step[static_cast<std::size_t>(a)];
+    const double meters = step * (s.stream.units == "in" ? 0.0254 : 0.001);
     config.steps_per_meter[a] = static_cast<std::uint32_t>(std::lround(1 / meters));
-    config.travel_steps[a] = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], s.step);
+    config.travel_steps[a] = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], step);
   }
-  const double rate = std::floor(s.machine.speed / s.step);
+  // Path limits in steps of the coarsest axis, as stream's (ConfigFor).
+  const double coarsest = s.coarsest_step;
+  const double rate = std::floor(s.machine.speed / coarsest);
   config.max_rate = static_cast<std::uint32_t>(std::clamp(rate, 1.0, double(tick_hz)));
-  config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / s.step)));
+  config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / coarsest)));
   config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
   // Jogs and gotos run with the pen up, so at the travel speed; each axis
   // gets the limit stream gives it (ConfigFor).
   const double travel_speed = s.machine.travel_speed > 0 ? s.machine.travel_speed : s.machine.speed;
-  const double travel_rate = std::floor(travel_speed / s.step);
+  const double travel_rate = std::floor(travel_speed / coarsest);
   config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
   for (int a = 0; a < s.axes; ++a) {
     const double given = s.machine.axis_accel[static_cast<std::size_t>(a)];
-    const double axis_accel = given > 0 ? std::floor(given / s.step) : 2.0 * config.accel;
+    const double axis_accel =
+        given > 0 ? std::floor(given / s.step[static_cast<std::size_t>(a)]) : 2.0 * config.accel;
     config.axis_accel[a] =
         static_cast<std::uint32_t>(std::clamp(axis_accel, config.accel + 1.0, 4e9));
   }
@@ -164,7 +170,8 @@ class SimConnection final : public Connection {
     if (o.tick_hz != 0) options.tick_hz = o.tick_hz;
     options.endstops = true;
     for (int a = 0; a < s.axes; ++a) {
-      const std::int32_t travel = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], s.step);
+      const std::int32_t travel = ToSteps(s.machine.travel[static_cast<std::size_t>(a)],
+                                          s.step[static_cast<std::size_t>(a)]);
       options.endstop_options.start_offset[a] = a == 0 ? travel / 3 : travel / 4;
     }
     plotter_ = std::make_unique<sim::SimulatedPlotter>(options);
@@ -190,14 +197,15 @@ class SimConnection final : public Connection {
     std::string note = "sim: the carriage stands";
     for (int a = 0; a < s.axes; ++a) {
       note += std::string(a == 0 ? " " : ", ") + kAxisLetters[a] + " " +
-              FormatNumber(static_cast<double>(switches.real_position(a)) * s.step);
+              FormatNumber(static_cast<double>(switches.real_position(a)) *
+                           s.step[static_cast<std::size_t>(a)]);
     }
     return note + " " + s.stream.units + " from its min switches (it started at " +
            FormatNumber(static_cast<double>(switches.real_position(0) - plotter_->position()[0]) *
-                        s.step) +
+                        s.step[0]) +
            ", " +
            FormatNumber(static_cast<double>(switches.real_position(1) - plotter_->position()[1]) *
-                        s.step) +
+                        s.step[1]) +
            ")";
   }
 
@@ -218,7 +226,7 @@ std::string Where(const Settings& s, const protocol::StatusReport& r) {
   std::string steps;
   for (int a = 0; a < s.axes; ++a) {
     text += std::string(a == 0 ? " " : ", ") + kAxisLetters[a] + " " +
-            FormatNumber(r.position[a] * s.step);
+            FormatNumber(r.position[a] * s.step[static_cast<std::size_t>(a)]);
     steps += (a == 0 ? "" : ", ") + std::to_string(r.position[a]);
   }
   text += " " + s.stream.units + " (steps " + steps + "); pen " + (r.pen_down ? "down" : "up") +
@@ -313,14 +321,18 @@ protocol::Command HomeOf(const ManualOptions& o, const Settings& s,
   const double rate = HomingLength(s, o.rate, "--rate", "homing.rate", 5, &rate_from);
   const double backoff =
       HomingLength(s, o.backoff, "--backoff", "homing.backoff", 1, &backoff_from);
-  const double rate_steps = std::floor(rate / s.step);
+  // HOME has one rate and one back-off for every axis: the rate in steps of
+  // the coarsest axis (no axis searches faster), the back-off in the finest
+  // (a coarser axis backs off farther).
+  const double finest = *std::min_element(s.step.begin(), s.step.begin() + s.axes);
+  const double rate_steps = std::floor(rate / s.coarsest_step);
   if (!(rate_steps >= 1 && rate_steps <= tick_hz)) {
     throw InputError(rate_from + ": " + FormatNumber(rate) + " " + s.stream.units +
                      "/s is not between one step per second and the device's " +
                      std::to_string(tick_hz) + " steps/s");
   }
   home.rate = static_cast<std::uint32_t>(rate_steps);
-  const std::int32_t backoff_steps = ToSteps(backoff, s.step);
+  const std::int32_t backoff_steps = ToSteps(backoff, finest);
   if (backoff < 0 || backoff_steps > config.travel_steps[0]) {
     throw InputError(backoff_from + ": " + FormatNumber(backoff) + " " + s.stream.units +
                      " is not within the travel");
@@ -357,14 +369,15 @@ protocol::Command MoveOf(const std::string& action, const ManualOptions& o, cons
   for (int a = 0; a < s.axes; ++a) {
     const bool has = static_cast<std::size_t>(a) < given;
     const double value = has ? NumberArg(action, o.args[static_cast<std::size_t>(a)]) : 0;
-    const double steps = action == "jog" ? now.position[a] + std::round(value / s.step)
-                         : has           ? std::round(value / s.step)
+    const double step = s.step[static_cast<std::size_t>(a)];
+    const double steps = action == "jog" ? now.position[a] + std::round(value / step)
+                         : has           ? std::round(value / step)
                                          : now.position[a];
     if (!(steps >= 0 && steps <= config.travel_steps[a])) {
       throw InputError("machine " + action + ": the target " + kAxisLetters[a] + " " +
-                       FormatNumber(steps * s.step) + " " + s.stream.units +
-                       " is outside the travel 0.." +
-                       FormatNumber(config.travel_steps[a] * s.step) + " " + s.stream.units);
+                       FormatNumber(steps * step) + " " + s.stream.units +
+                       " is outside the travel 0.." + FormatNumber(config.travel_steps[a] * step) +
+                       " " + s.stream.units);
     }
     command.body.move.target[a] = static_cast<std::int32_t>(steps);
   }

@@ -107,22 +107,6 @@ std::string RefusedText(KeyCheck check, const std::string& text) {
   return "";
 }
 
-// Steps per unit, one per axis, must agree: the host plans every axis on
-// one step (the quantum of the drawing, docs/precision.md), so a machine
-// whose axes differ is refused rather than drawn out of scale.
-void CheckOneStep(const MachineKey& key, const ProfileValue& value, const toml::node& node,
-                  const std::string& path) {
-  for (const double n : value.numbers) {
-    if (n == value.numbers.front()) continue;
-    std::string given;
-    for (const double m : value.numbers) given += (given.empty() ? "" : ", ") + FormatNumber(m);
-    throw KeyError(path, node.source(), key.name,
-                   "the axes differ (" + given +
-                       "): fdsurf plans every axis on one step, so every axis's steps per unit "
-                       "must be equal (docs/machines.md)");
-  }
-}
-
 // The value of `key` as the schema says it must be; throws KeyError.
 ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std::string& path) {
   ProfileValue value;
@@ -171,7 +155,6 @@ ProfileValue ReadValue(const MachineKey& key, const toml::node& node, const std:
       break;
     }
   }
-  if (key.type == KeyType::kStepsPer) CheckOneStep(key, value, node, path);
   for (const double n : value.numbers) {
     const bool positive = key.check == KeyCheck::kPositive || key.check == KeyCheck::kQuantum ||
                           key.type == KeyType::kLengthList || key.type == KeyType::kStepsPer;
@@ -270,11 +253,11 @@ const std::vector<MachineKey>& MachineKeys() {
        "stream: sim, usb[:VID:PID], serial:PATH[:BAUD], serial:auto or gpio:CHIP:LINES"},
       {"dims", T::kInteger, "", "--dims", C::kNone, "2 (pen plotter) or 3 (with Z, for CNC)"},
       {"step", T::kLength, "units", "--step", C::kQuantum,
-       "stream: length of one motor step, every axis"},
+       "stream: length of one motor step, every axis (per axis: steps_per_mm)"},
       {"steps_per_mm", T::kStepsPer, "steps/mm", "--step", C::kPositive,
-       "stream: motor steps per mm, every axis or [X, Y, Z] (equal); instead of step"},
+       "stream: motor steps per mm, every axis or [X, Y] or [X, Y, Z]; instead of step"},
       {"steps_per_in", T::kStepsPer, "steps/in", "--step", C::kPositive,
-       "stream: motor steps per inch, every axis or [X, Y, Z] (equal); instead of step"},
+       "stream: motor steps per inch, every axis or [X, Y] or [X, Y, Z]; instead of step"},
       {"travel", T::kLengthList, "units", "--travel", C::kPositive,
        "stream: machine travel [W, H] or [W, H, D]"},
       {"speed", T::kLength, "units/s", "--speed", C::kPositive,
@@ -461,8 +444,13 @@ std::string OptionText(const MachineProfile& profile, const ProfileValue& value,
     // The step, 1/N in the key's own unit, in the command's units; a step
     // that is no short decimal there is refused by --step's check.
     const std::string per = std::string(key.name).substr(std::string(key.name).size() - 2);
-    const double step_mm = (per == "in" ? 25.4 : 1.0) / value.numbers.front();
-    return FormatOptionNumber(command_units == "in" ? step_mm / 25.4 : step_mm);
+    std::string text;
+    for (const double n : value.numbers) {
+      const double step_mm = (per == "in" ? 25.4 : 1.0) / n;
+      text += (text.empty() ? "" : ",") +
+              FormatOptionNumber(command_units == "in" ? step_mm / 25.4 : step_mm);
+    }
+    return text;
   }
   double scale = 1;
   if (IsLength(key) && profile.units != command_units)
@@ -515,8 +503,12 @@ void ApplyMachineProfile(const MachineProfile& profile, CLI::App* command) {
       return InputError(message);
     };
     try {
-      if (value.key->check == KeyCheck::kQuantum || value.key->type == KeyType::kStepsPer) {
-        (void)Quantum::Parse(text, value.key->option);
+      if (value.key->check == KeyCheck::kQuantum) (void)Quantum::Parse(text, value.key->option);
+      if (value.key->type == KeyType::kStepsPer) {
+        std::stringstream steps(text);
+        for (std::string step; std::getline(steps, step, ',');) {
+          (void)Quantum::Parse(step, value.key->option);
+        }
       }
       option->add_result(text);
       option->run_callback();
@@ -524,10 +516,14 @@ void ApplyMachineProfile(const MachineProfile& profile, CLI::App* command) {
       throw refuse(e.what());
     } catch (const InputError& e) {
       if (value.key->type != KeyType::kStepsPer) throw refuse(e.what());
-      std::string why = "one step, 1/" + FormatNumber(value.numbers.front()) + " ";
+      std::string why = "a step of 1/N ";
       why += std::string(value.key->name).substr(10);  // "mm" or "in" of steps_per_
-      why += ", is " + text;
-      why += " " + units;
+      why += " for N = " + FormatOptionNumber(value.numbers.front());
+      for (std::size_t k = 1; k < value.numbers.size(); ++k) {
+        why += ", " + FormatOptionNumber(value.numbers[k]);
+      }
+      why += " (" + text;
+      why += " " + units + ") is";
       why +=
           ", not a decimal of at most 9 significant digits and 9 decimals as a step must be "
           "(docs/precision.md): give 'step' in ";

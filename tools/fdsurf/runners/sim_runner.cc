@@ -49,6 +49,7 @@ std::string AxisAccelText(const std::array<double, 3>& axis_accel, int axes) {
 // points (the teapot's SVG: 14.8 MB instead of 26; it stays the exact step path).
 Toolpath DrawnToolpath(const StreamJob& job, const std::vector<sim::DrawnPath>& paths) {
   Toolpath drawn = job.page;
+  drawn.quantum = PageQuantum(job);
   drawn.strokes.clear();
   for (const sim::DrawnPath& path : paths) {
     Stroke stroke;
@@ -58,7 +59,7 @@ Toolpath DrawnToolpath(const StreamJob& job, const std::vector<sim::DrawnPath>& 
                                     p[k][0] - p[k - 1][0] == p[k + 1][0] - p[k][0] &&
                                     p[k][1] - p[k - 1][1] == p[k + 1][1] - p[k][1] &&
                                     p[k][2] - p[k - 1][2] == p[k + 1][2] - p[k][2];
-      if (!straight_through) stroke.points.push_back(PageSteps(job, p[k]));
+      if (!straight_through) stroke.points.push_back(PagePosition(job, p[k]));
     }
     drawn.strokes.push_back(std::move(stroke));
   }
@@ -149,9 +150,42 @@ sim::RunResult StreamToPlotter(const StreamOptions& o, const StreamJob& job,
   return run;
 }
 
+// How a step event becomes output units. With one step for every axis the
+// figures are counted in steps (a step of two axes at once √2) and scaled by
+// the step once, as they always were; a machine whose axes step differently
+// counts each event as √(Σ step_a²) of the axes in it, in output units.
+struct StepLengths {
+  bool uniform = true;
+  double scale = 1;                 // output units per counted unit
+  std::array<double, 8> of_mask{};  // counted units of a step of the axes in the mask
+  std::array<double, 3> axis{};     // each axis's step, output units
+  double coarsest = 0;              // the longest step: a deviation bound's
+};
+
+StepLengths StepLengthsOf(const StreamJob& job) {
+  StepLengths l;
+  const int dims = job.page.dims;
+  for (std::size_t a = 0; a < 3; ++a) l.axis[a] = job.steps[a].value();
+  for (int a = 0; a < dims; ++a) {
+    l.uniform = l.uniform && l.axis[static_cast<std::size_t>(a)] == l.axis[0];
+    l.coarsest = std::max(l.coarsest, l.axis[static_cast<std::size_t>(a)]);
+  }
+  l.scale = l.uniform ? l.axis[0] : 1;
+  for (unsigned mask = 0; mask < 8; ++mask) {
+    double squares = 0;
+    for (std::size_t a = 0; a < 3; ++a) {
+      if ((mask >> a & 1u) != 0) squares += l.uniform ? 1 : l.axis[a] * l.axis[a];
+    }
+    l.of_mask[mask] = std::sqrt(squares);
+  }
+  return l;
+}
+
 // What the plotter drew, checked against the exact curves and the limits.
 struct CheckedDrawing {
   std::vector<sim::DrawnPath> drawn;
+  /// The path's length, pen up and down, output units.
+  double path_length = 0;
   sim::DrawingComparison comparison;
   sim::MotionReport motion;
   /// The deviation bound in steps: the tolerance, plus what the reference
@@ -178,6 +212,14 @@ CheckedDrawing CheckDrawing(const sim::SimulatedPlotter& plotter, const PatchSet
   for (std::size_t a = 0; a < 3; ++a) limits.axis_accel_each[a] = job.config.axis_accel[a];
   limits.pen_delay_s = job.config.pen_delay_ms * 1e-3;
   checked.motion = sim::CheckMotion(plotter.step_events(), plotter.pen_events(), limits);
+  const StepLengths lengths = StepLengthsOf(job);
+  if (lengths.uniform) {
+    checked.path_length = checked.motion.path_length * lengths.scale;
+  } else {
+    for (const hal::StepDirEvent& e : plotter.step_events()) {
+      checked.path_length += lengths.of_mask[e.axis_mask & 7u];
+    }
+  }
   checked.bound = job.tolerance_steps + 0.005;
   checked.within = checked.comparison.max_deviation <= checked.bound &&
                    checked.comparison.max_gap <= checked.bound;
@@ -232,7 +274,11 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                  const ToolpathOptions& drawing, const std::string& units,
                  const sim::PlotterOptions& plotter_options, const sim::RunResult& run,
                  const CheckedDrawing& checked) {
-  const double step = job.page.quantum.value();
+  const StepLengths lengths = StepLengthsOf(job);
+  // Speeds and deviations in steps are bounded in output units by the
+  // coarsest step (exact when the axes agree).
+  const double step = lengths.coarsest;
+  const char* at_most = lengths.uniform ? "" : "at most ";
   const sim::DrawingComparison& comparison = checked.comparison;
   const sim::MotionReport& motion = checked.motion;
   std::size_t points = 0;
@@ -264,15 +310,15 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
       static_cast<int>(std::max_element(axis_accel.begin(), axis_accel.end()) - axis_accel.begin());
   std::fprintf(stderr,
                "machine: %.1f s, %zu moves, %.0f %s of path (%zu pen-down strokes, %zu points), "
-               "top speed %.1f %s/s, top axis acceleration %s %s/s² (%c)\n",
-               motion.duration_s, motion.moves, motion.path_length * step, units.c_str(),
-               checked.drawn.size(), points, motion.max_speed * step, units.c_str(),
-               FormatNumber(axis_accel[fastest_axis] * step, 4).c_str(), units.c_str(),
-               "XYZ"[fastest_axis]);
+               "top speed %s%.1f %s/s, top axis acceleration %s %s/s² (%c)\n",
+               motion.duration_s, motion.moves, checked.path_length, units.c_str(),
+               checked.drawn.size(), points, at_most, motion.max_speed * step, units.c_str(),
+               FormatNumber(axis_accel[fastest_axis] * lengths.axis[fastest_axis], 4).c_str(),
+               units.c_str(), "XYZ"[fastest_axis]);
   std::fprintf(stderr,
-               "drawing vs exact curves: max deviation %.3f steps (%.4f %s), max gap %.3f steps; "
+               "drawing vs exact curves: max deviation %.3f steps (%s%.4f %s), max gap %.3f steps; "
                "bound %.3f steps (--tolerance): %s\n",
-               comparison.max_deviation, comparison.max_deviation * step, units.c_str(),
+               comparison.max_deviation, at_most, comparison.max_deviation * step, units.c_str(),
                comparison.max_gap, checked.bound, checked.within ? "within" : "BOUND VIOLATED");
   const std::string limits =
       checked.limits_kept
@@ -312,8 +358,8 @@ namespace {
 // What a dry run measures of the recorded motion. Distances are the motors':
 // a step of two axes at once counts √2 steps (as the summary's path length).
 struct DryRunFigures {
-  double machine_s = 0;  // the last step, as CheckMotion's duration
-  double pen_down_steps = 0;
+  double machine_s = 0;       // the last step, as CheckMotion's duration
+  double pen_down_steps = 0;  // in StepLengths' counted units
   double pen_up_steps = 0;
   std::size_t pen_lifts = 0;
   std::array<std::int64_t, 3> lo{}, hi{};  // the positions drawn (pen down)
@@ -323,10 +369,13 @@ struct DryRunFigures {
 DryRunFigures MeasureDryRun(const StreamJob& job, const sim::SimulatedPlotter& plotter,
                             const std::vector<sim::DrawnPath>& drawn) {
   DryRunFigures f;
+  const StepLengths lengths = StepLengthsOf(job);
+  const std::array<double, 3> counted =
+      lengths.uniform ? std::array<double, 3>{1, 1, 1} : lengths.axis;
   double total = 0;
   for (const hal::StepDirEvent& e : plotter.step_events()) {
     if (e.axis_mask == 0) continue;
-    total += std::sqrt(static_cast<double>(__builtin_popcount(e.axis_mask)));
+    total += lengths.of_mask[e.axis_mask & 7u];
     f.machine_s = e.time_us * 1e-6;
   }
   for (const sim::DrawnPath& path : drawn) {
@@ -340,9 +389,9 @@ DryRunFigures MeasureDryRun(const StreamJob& job, const sim::SimulatedPlotter& p
       f.drew = true;
       if (k == 0) continue;
       const auto& q = path.points[k - 1];
-      f.pen_down_steps +=
-          std::hypot(static_cast<double>(p[0] - q[0]), static_cast<double>(p[1] - q[1]),
-                     static_cast<double>(p[2] - q[2]));
+      f.pen_down_steps += std::hypot(static_cast<double>(p[0] - q[0]) * counted[0],
+                                     static_cast<double>(p[1] - q[1]) * counted[1],
+                                     static_cast<double>(p[2] - q[2]) * counted[2]);
     }
   }
   f.pen_up_steps = std::max(0.0, total - f.pen_down_steps);
@@ -360,7 +409,9 @@ std::string TickSource(const StreamOptions& o) {
 
 void PrintDryRun(const StreamOptions& o, const StreamJob& job, std::uint32_t tick_hz,
                  const DryRunFigures& f) {
-  const double step = job.page.quantum.value();
+  const StepLengths lengths = StepLengthsOf(job);
+  const double step = lengths.scale;
+  const auto& axis = lengths.axis;
   const char* units = o.units.c_str();
   std::printf(
       "%s: dry run of %s on the simulated plotter (%d axes, %u Hz ticks, %s); nothing "
@@ -372,11 +423,11 @@ void PrintDryRun(const StreamOptions& o, const StreamJob& job, std::uint32_t tic
               f.pen_down_steps * step, units, f.pen_up_steps * step, units, f.pen_lifts,
               f.pen_lifts == 1 ? "" : "s");
   if (f.drew) {
-    std::string extent = "page extent drawn: x " + FormatNumber(f.lo[0] * step) + ".." +
-                         FormatNumber(f.hi[0] * step) + ", y " + FormatNumber(f.lo[1] * step) +
-                         ".." + FormatNumber(f.hi[1] * step);
+    std::string extent = "page extent drawn: x " + FormatNumber(f.lo[0] * axis[0]) + ".." +
+                         FormatNumber(f.hi[0] * axis[0]) + ", y " +
+                         FormatNumber(f.lo[1] * axis[1]) + ".." + FormatNumber(f.hi[1] * axis[1]);
     if (o.dims == 3) {
-      extent += ", z " + FormatNumber(f.lo[2] * step) + ".." + FormatNumber(f.hi[2] * step);
+      extent += ", z " + FormatNumber(f.lo[2] * axis[2]) + ".." + FormatNumber(f.hi[2] * axis[2]);
     }
     std::printf("%s %s\n", extent.c_str(), units);
   } else {

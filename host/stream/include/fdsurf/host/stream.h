@@ -7,12 +7,14 @@
 // the quantum = one step). The device then evaluates the isolines itself.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "fdsurf/config/nodiscard.h"
 #include "fdsurf/host/hidden_lines.h"
 #include "fdsurf/host/patch_set.h"
 #include "fdsurf/host/plan.h"
@@ -36,7 +38,25 @@ std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text);
 /// does, stream_command.cc).
 struct MachineOptions {
   /// Length of one motor step; every position is a whole number of steps.
+  /// X's, and every axis's that has no step of its own in `own_step`.
   Quantum step = Quantum::Parse("0.0125");
+  /// Y's and Z's steps (index 1, 2) where they differ from `step` (a
+  /// leadscrew Z under belt-driven X and Y); index 0 is not used. The job
+  /// then gives the device each axis in its own steps, and its path speed
+  /// and acceleration limits in steps of the coarsest axis (so that no
+  /// direction exceeds them); docs/machines.md, "Steps per unit".
+  std::array<std::optional<Quantum>, 3> own_step{};
+  /// Axis `axis`'s step (0 X, 1 Y, 2 Z).
+  FDSURF_NODISCARD const Quantum& StepOf(int axis) const {
+    const std::optional<Quantum>& own = own_step[static_cast<std::size_t>(axis)];
+    return axis > 0 && own ? *own : step;
+  }
+  /// The longest step of the first `dims` axes.
+  FDSURF_NODISCARD double CoarsestStep(int dims) const {
+    double coarsest = 0;
+    for (int a = 0; a < dims; ++a) coarsest = std::max(coarsest, StepOf(a).value());
+    return coarsest;
+  }
   /// Travel of each axis from 0; {0, 0, 0} means the page (and, in 3-D, the
   /// drawing's depth).
   std::array<double, 3> travel{0, 0, 0};
@@ -98,9 +118,15 @@ struct StreamJob {
   /// The start of every layer of curves, in drawing order, when the file
   /// has layers (PatchSet::layers not empty); runners pause between them.
   std::vector<LayerStart> layers;
-  /// The page and the map from file units to output units; quantum = step.
+  /// The page and the map from file units to output units; quantum = X's
+  /// step.
   Toolpath page;
-  /// Tolerance in steps, and as the devices's 2^-8-step units.
+  /// Each axis's step (MachineOptions::StepOf): a position of axis a in
+  /// steps is that many steps[a] in output units.
+  std::array<Quantum, 3> steps{};
+  /// Tolerance in steps (of the coarsest axis: a deviation of that many
+  /// steps of any axis is within the tolerance), and as the devices's
+  /// 2^-8-step units.
   double tolerance_steps = 0;
   std::uint32_t tolerance_q8 = 0;
   /// Edge lines left out because a patch earlier in the order draws the
@@ -113,9 +139,20 @@ struct StreamJob {
   std::array<std::int64_t, 2> mirror_steps{0, 0};
 };
 
-/// A point the machine drew (steps, its own axes) on the page (steps from
-/// the page's origin): the identity unless the job mirrors an axis.
+/// A point the machine drew (steps, its own axes) on the page (each axis's
+/// steps from the page's origin): the identity unless the job mirrors an
+/// axis.
 std::array<std::int64_t, 3> PageSteps(const StreamJob& job, std::array<std::int64_t, 3> machine);
+
+/// The largest decimal that divides the step of every axis the job drives:
+/// X's step when they agree (0.0025 for 0.0125 and 0.01). The quantum of a
+/// drawn toolpath (the pictures of what the machine drew).
+Quantum PageQuantum(const StreamJob& job);
+
+/// A point the machine drew on the page in PageQuantum(job): PageSteps,
+/// then each axis's steps as whole multiples of that quantum.
+std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
+                                         const std::array<std::int64_t, 3>& machine);
 
 /// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
 /// tolerance, dims; the quantum is replaced by machine.step). The plan

@@ -176,6 +176,15 @@ void PatchToQuanta(const Patch& patch, const OutputMap& map, const Quantum& quan
 void CurveToQuanta(const Curve& curve, const OutputMap& map, const Quantum& quantum, int dims,
                    CurveGeometry1* geometry);
 
+/// Both with a quantum per axis (a machine whose axes step differently):
+/// axis c in quanta[c]. An affine map of a Bézier, Hermite, B-spline,
+/// Catmull-Rom or power-basis net is the net of the mapped surface, so the
+/// scaling per axis is exact before the rounding to 2^-16 quanta.
+void PatchToQuanta(const Patch& patch, const OutputMap& map, const std::array<Quantum, 3>& quanta,
+                   int dims, PatchGeometry1* geometry);
+void CurveToQuanta(const Curve& curve, const OutputMap& map, const std::array<Quantum, 3>& quanta,
+                   int dims, CurveGeometry1* geometry);
+
 /// Draws every patch's isolines, then the file's curves, each stroke with its
 /// layer and its exact cubic (Stroke::cubics). Throws as PlanPage
 /// for options that cannot be met (tolerance below the quantum's reach, a
