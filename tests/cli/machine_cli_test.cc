@@ -164,33 +164,37 @@ TEST_F(MachineCli, MachineShowNamesWhereEachSettingCameFrom) {
   const RunResult r = Run("machine show --machine '" + sim + "' --speed 60");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("profile " + sim + " (its lengths in mm)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("speed        60                   mm/s       --speed        command line"),
+  EXPECT_NE(
+      r.out.find(
+          "speed              60                   mm/s       --speed              command line"),
+      std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(
+                "accel              1500                 mm/s²      --accel              profile " +
+                sim + ":10"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("accel        1500                 mm/s²      --accel        profile " +
-                       sim + ":10"),
-            std::string::npos)
-      << r.out;
-  EXPECT_NE(r.out.find("feed         1500                 mm/min     --feed         default"),
-            std::string::npos)
+  EXPECT_NE(
+      r.out.find("feed               1500                 mm/min     --feed               default"),
+      std::string::npos)
       << r.out;
   // In inches: the profile's millimetres converted (254 mm = 10 in). A step
   // of 0.0125 mm would be refused: 0.000492... in is no short decimal.
   const std::string mm = Write("mm.toml", "units = \"mm\"\ntravel = [254, 127]\n");
   const RunResult in = Run("machine show --machine '" + mm + "' --units in");
   ASSERT_EQ(in.exit_code, 0) << in.err;
-  EXPECT_NE(in.out.find("travel       10x5                 in"), std::string::npos) << in.out;
+  EXPECT_NE(in.out.find("travel             10x5                 in"), std::string::npos) << in.out;
   EXPECT_EQ(Run("machine show --machine '" + sim + "' --units in").exit_code, 2);
   // The built-in defaults as the commands convert them (1500 mm/min, 100 mm/s).
   const RunResult defaults = Run("machine show --units in");
   ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
-  EXPECT_NE(
-      defaults.out.find("feed         59.0551              in/min     --feed         default"),
-      std::string::npos)
+  EXPECT_NE(defaults.out.find(
+                "feed               59.0551              in/min     --feed               default"),
+            std::string::npos)
       << defaults.out;
-  EXPECT_NE(
-      defaults.out.find("speed        3.93701              in/s       --speed        default"),
-      std::string::npos)
+  EXPECT_NE(defaults.out.find(
+                "speed              3.93701              in/s       --speed              default"),
+            std::string::npos)
       << defaults.out;
 }
 
@@ -213,7 +217,7 @@ TEST_F(MachineCli, ProfileUnderHomeConfigIsShownWithATilde) {
   const ScopedEnv xdg("XDG_CONFIG_HOME", nullptr);
   const RunResult r = Run("machine show --machine mine");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("42                   mm/s       --speed        profile "
+  EXPECT_NE(r.out.find("42                   mm/s       --speed              profile "
                        "~/.config/fdsurf/machines/mine.toml:2"),
             std::string::npos)
       << r.out;
@@ -291,18 +295,20 @@ TEST_F(MachineCli, StreamOnAMachineThatRequiresHomingSaysToHome) {
 TEST_F(MachineCli, MachineShowPrintsTheHomingSettingsAndTheirSource) {
   const RunResult r = Run("machine show --machine '" + kMachines + "/ramps.toml' --rate 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("homing.rate  3                    mm/s       --rate         command line"),
-            std::string::npos)
+  EXPECT_NE(
+      r.out.find(
+          "homing.rate        3                    mm/s       --rate               command line"),
+      std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("homing.toward min"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("false                -          --require-homing profile " + kMachines +
+  EXPECT_NE(r.out.find("homing.toward      min"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("false                -          --require-homing     profile " + kMachines +
                        "/ramps.toml:"),
             std::string::npos)
       << r.out;
   const RunResult defaults = Run("machine show");
   ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
-  EXPECT_NE(defaults.out.find("homing.backoff 1 "), std::string::npos) << defaults.out;
-  EXPECT_NE(defaults.out.find("homing.axes  all"), std::string::npos) << defaults.out;
+  EXPECT_NE(defaults.out.find("homing.backoff     1 "), std::string::npos) << defaults.out;
+  EXPECT_NE(defaults.out.find("homing.axes        all"), std::string::npos) << defaults.out;
 }
 
 // The gpio device's ENDSTOPS part is checked before any line is opened:

@@ -2,8 +2,10 @@
 #include "machine_command.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -163,7 +165,16 @@ int RunMachineShow(const MachineShowOptions& options) {
     std::printf("no profile (--machine NAME|FILE)\n");
   }
   std::printf("units %s (%s)\n", units.c_str(), options.units.empty() ? "default" : "command line");
-  std::printf("%-12s %-20s %-10s %-14s %s\n", "key", "value", "unit", "option", "source");
+  // The key and option columns as wide as their longest entry
+  // (servo_pulse_down, --servo-pulse-down), so that every row lines up.
+  int key_width = 3;
+  int option_width = 6;
+  for (const MachineKey& key : keys) {
+    key_width = std::max(key_width, static_cast<int>(std::strlen(key.name)));
+    option_width = std::max(option_width, static_cast<int>(std::strlen(key.option)));
+  }
+  std::printf("%-*s %-20s %-10s %-*s %s\n", key_width, "key", "value", "unit", option_width,
+              "option", "source");
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const MachineKey& key = keys[i];
     if (key.option[0] == '\0') continue;
@@ -173,8 +184,8 @@ int RunMachineShow(const MachineShowOptions& options) {
       std::string counts;
       for (const double n : in_profile->numbers)
         counts += (counts.empty() ? "" : ",") + FormatNumber(n);
-      std::printf("%-12s %-20s %s %-14s %s\n", key.name, counts.c_str(),
-                  PadTo(key.unit, 10).c_str(), key.option,
+      std::printf("%-*s %-20s %s %-*s %s\n", key_width, key.name, counts.c_str(),
+                  PadTo(key.unit, 10).c_str(), option_width, key.option,
                   ("profile " + ForShow(SourceOf(profile, *in_profile))).c_str());
       continue;
     }
@@ -195,8 +206,9 @@ int RunMachineShow(const MachineShowOptions& options) {
       source = "default";
     }
     const std::string unit = UnitText(key, units);
-    std::printf("%-12s %-20s %s %-14s %s\n", key.name, value.c_str(),
-                PadTo(unit.empty() ? "-" : unit.substr(1), 10).c_str(), key.option, source.c_str());
+    std::printf("%-*s %-20s %s %-*s %s\n", key_width, key.name, value.c_str(),
+                PadTo(unit.empty() ? "-" : unit.substr(1), 10).c_str(), option_width, key.option,
+                source.c_str());
   }
   return 0;
 }
