@@ -546,6 +546,16 @@ void MirrorForTheOrigin(MachineOrigin origin, StreamJob* job) {
 
 }  // namespace
 
+protocol::MachineConfig MachineConfigFor(const MachineOptions& machine, int dims,
+                                         const std::string& units) {
+  Toolpath travel;
+  travel.dims = dims;
+  travel.width = machine.travel[0];
+  travel.height = machine.travel[1];
+  travel.depth = dims == 3 ? machine.travel[2] : 0;
+  return ConfigFor(machine, travel, units);
+}
+
 std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text) {
   if (text == "bottom-left") return MachineOrigin::kBottomLeft;
   if (text == "top-left") return MachineOrigin::kTopLeft;

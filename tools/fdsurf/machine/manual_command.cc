@@ -82,34 +82,13 @@ std::int32_t ToSteps(double length, double step) {
   return static_cast<std::int32_t>(std::floor(length / step + 1e-9));
 }
 
+// stream's configuration (MachineConfigFor: steps, travel, limits, per-axis
+// acceleration, servo widths, homing flag), with the speed limits fitted
+// to the device's tick rate as stream fits a job (FitJobToDevice).
 protocol::MachineConfig ConfigOf(const Settings& s, std::uint32_t tick_hz) {
-  protocol::MachineConfig config{};
-  config.axes = static_cast<std::uint8_t>(s.axes);
-  for (int a = 0; a < s.axes; ++a) {
-    const double step = s.step[static_cast<std::size_t>(a)];
-    const double meters = step * (s.stream.units == "in" ? 0.0254 : 0.001);
-    config.steps_per_meter[a] = static_cast<std::uint32_t>(std::lround(1 / meters));
-    config.travel_steps[a] = ToSteps(s.machine.travel[static_cast<std::size_t>(a)], step);
-  }
-  // Path limits in steps of the coarsest axis, as stream's (ConfigFor).
-  const double coarsest = s.coarsest_step;
-  const double rate = std::floor(s.machine.speed / coarsest);
-  config.max_rate = static_cast<std::uint32_t>(std::clamp(rate, 1.0, double(tick_hz)));
-  config.accel = static_cast<std::uint32_t>(std::max(1.0, std::floor(s.machine.accel / coarsest)));
-  config.pen_delay_ms = static_cast<std::uint16_t>(s.machine.pen_delay_ms);
-  // Jogs and gotos run with the pen up, so at the travel speed; each axis
-  // gets the limit stream gives it (ConfigFor).
-  const double travel_speed = s.machine.travel_speed > 0 ? s.machine.travel_speed : s.machine.speed;
-  const double travel_rate = std::floor(travel_speed / coarsest);
-  config.travel_rate = static_cast<std::uint32_t>(std::clamp(travel_rate, 1.0, double(tick_hz)));
-  for (int a = 0; a < s.axes; ++a) {
-    const double given = s.machine.axis_accel[static_cast<std::size_t>(a)];
-    const double axis_accel =
-        given > 0 ? std::floor(given / s.step[static_cast<std::size_t>(a)]) : 2.0 * config.accel;
-    config.axis_accel[a] =
-        static_cast<std::uint32_t>(std::clamp(axis_accel, config.accel + 1.0, 4e9));
-  }
-  config.flags = s.stream.require_homing ? protocol::kConfigFlagHomingRequired : 0;
+  protocol::MachineConfig config = MachineConfigFor(s.machine, s.axes, s.stream.units);
+  config.max_rate = std::min(config.max_rate, tick_hz);
+  config.travel_rate = std::min(config.travel_rate, tick_hz);
   return config;
 }
 

@@ -139,6 +139,13 @@ struct StreamJob {
   std::array<std::int64_t, 2> mirror_steps{0, 0};
 };
 
+/// The CONFIG of `machine` for `dims` axes without a drawing (`fdsurf
+/// machine`'s commands): BuildStreamJob's configuration with the travel as
+/// the page. machine.travel must be given for every axis; throws OptionError
+/// as BuildStreamJob does for a limit the device cannot take.
+protocol::MachineConfig MachineConfigFor(const MachineOptions& machine, int dims,
+                                         const std::string& units);
+
 /// A point the machine drew (steps, its own axes) on the page (each axis's
 /// steps from the page's origin): the identity unless the job mirrors an
 /// axis.
