@@ -121,8 +121,10 @@ BOARDS = {
                        "job_args": "--fit 20x15 --lines 2 --speed 20 "
                                    "--servo-pulse-up 1200 --servo-pulse-down 1800"},
     "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
-                    "servo_us": None, "limits": MICROBIT_LIMITS,
-                    "job_args": "--fit 40x30 --lines 2"},
+                    "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
+                    "limits": MICROBIT_LIMITS,
+                    "job_args": "--fit 40x30 --lines 2 "
+                                "--servo-pulse-up 1200 --servo-pulse-down 1800"},
     "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
                 "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 2"},
 }
