@@ -80,28 +80,30 @@ constexpr uint32_t kServoPriority = 0;
 constexpr uint32_t kTickPriority = 1;
 constexpr uint32_t kUartPriority = 2;
 
-/// Masks the step tick's interrupt (TIMER0, in the NVIC) while it lives,
-/// restoring the previous state: the Device's InterruptLock (fdsurf/device/
-/// device.h). Not PRIMASK: the servo's interrupt must stay free to run,
-/// and a masked section (some take ~15 µs) would stretch or cut its pulse.
-/// (The M0 has no BASEPRI.) dsb + isb: no instruction after the constructor
-/// runs before the mask is in force.
+/// Masks the step tick's and the UART's interrupts (TIMER0, UART0, in the
+/// NVIC) while it lives, restoring the previous state: the Device's
+/// InterruptLock (fdsurf/device/device.h). Not PRIMASK: the servo's
+/// interrupt must stay free to run, and a masked section (some take
+/// ~15 µs) would stretch or cut its pulse (the M0 has no BASEPRI). The UART
+/// is masked too, as PRIMASK did: its handler drains every byte QEMU has
+/// (a burst of dozens), which inside a section delayed a tick by 53 µs.
+/// dsb + isb: no instruction after the constructor runs before the mask.
 class TickLock {
  public:
-  TickLock() : was_enabled_((nrf51::Reg(nrf51::kNvicIser) & kBit) != 0) {
-    nrf51::Reg(nrf51::kNvicIcer) = kBit;
+  TickLock() : was_enabled_(nrf51::Reg(nrf51::kNvicIser) & kBits) {
+    nrf51::Reg(nrf51::kNvicIcer) = kBits;
     __asm__ volatile("dsb\n\tisb" : : : "memory");
   }
   ~TickLock() {
     __asm__ volatile("" : : : "memory");
-    if (was_enabled_) nrf51::Reg(nrf51::kNvicIser) = kBit;
+    nrf51::Reg(nrf51::kNvicIser) = was_enabled_;
   }
   TickLock(const TickLock&) = delete;
   TickLock& operator=(const TickLock&) = delete;
 
  private:
-  static constexpr uint32_t kBit = 1u << nrf51::kTimerIrq;
-  bool was_enabled_;
+  static constexpr uint32_t kBits = (1u << nrf51::kTimerIrq) | (1u << nrf51::kUartIrq);
+  uint32_t was_enabled_;
 };
 
 /// Busy-waits about `loops` × 6 cycles on the M0 (2 nops, subs, a taken
