@@ -28,8 +28,8 @@ constexpr uint32_t kUartRx = 25;
 constexpr uint32_t Bit(uint32_t pin) { return 1u << pin; }
 constexpr uint32_t kStepBits[2] = {Bit(kXStep), Bit(kYStep)};
 constexpr uint32_t kDirBits[2] = {Bit(kXDir), Bit(kYDir)};
-constexpr uint32_t kOutputBits = Bit(kXStep) | Bit(kXDir) | Bit(kYStep) | Bit(kYDir) |
-                                 Bit(kEnable) | Bit(kPen) | Bit(kServo);
+constexpr uint32_t kOutputBits =
+    Bit(kXStep) | Bit(kXDir) | Bit(kYStep) | Bit(kYDir) | Bit(kEnable) | Bit(kPen) | Bit(kServo);
 
 /// The DIR level that means "towards negative" (waveform header), and the
 /// ENABLE level that energises the A4988/DRV8825 (active low).

@@ -53,9 +53,8 @@ void fdsurf_board_fault() {
   Reg(fdsurf::board::nrf51::kGpioOutSet) = fdsurf::board::pins::Bit(fdsurf::board::pins::kEnable);
   // No more servo pulses (its interrupt is masked now): the pin low, not
   // stuck high; a PEN line goes up.
-  Reg(fdsurf::board::nrf51::kGpioOutClr) =
-      fdsurf::board::pins::Bit(fdsurf::board::pins::kServo) |
-      fdsurf::board::pins::Bit(fdsurf::board::pins::kPen);
+  Reg(fdsurf::board::nrf51::kGpioOutClr) = fdsurf::board::pins::Bit(fdsurf::board::pins::kServo) |
+                                           fdsurf::board::pins::Bit(fdsurf::board::pins::kPen);
   uint32_t ipsr;
   __asm__ volatile("mrs %0, ipsr" : "=r"(ipsr));
   fdsurf_board_stats.fault = ipsr == 0 ? 0xFFu : ipsr;
