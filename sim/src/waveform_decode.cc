@@ -23,7 +23,7 @@ int Index(WaveSignal signal) { return static_cast<int>(signal); }
 bool IsEdgeSignal(int s) { return s == Index(WaveSignal::kServo) || (s < 9 && s % 3 == 0); }
 
 // Converts pin times (ns) to the simulator's µs, snapped to the board's tick
-// grid when its rate is known (phase: the first STEP edge).
+// grid when its rate is known.
 //
 // A board writes its pins at different points of its tick interrupt (a pen
 // change early, a step after the motion's arithmetic) and the interrupt
@@ -33,37 +33,50 @@ bool IsEdgeSignal(int s) { return s == Index(WaveSignal::kServo) || (s < 9 && s 
 // and EN changes happen in the tick of the step they prepare and never
 // before the last move or pen change (StateMicros). The order of the
 // recording is kept; only times move, by less than a tick.
+//
+// The grid is counted from the last unit move or pen change (the first STEP
+// edge before any): an event is the nearest whole number of ticks after it.
+// A grid fixed at the first edge fails when the recording's clock and the
+// board's timer differ a little (QEMU's instruction count against its
+// virtual clock: ~50 µs a second): the grid slides through the ticks, and
+// a 2-tick interval of a late edge then an early one rounded to 1 tick.
 class TimeBase {
  public:
-  TimeBase(std::uint32_t tick_hz, std::int64_t phase_ns) : tick_hz_(tick_hz), phase_ns_(phase_ns) {}
+  TimeBase(std::uint32_t tick_hz, std::int64_t phase_ns)
+      : tick_hz_(tick_hz), phase_ns_(phase_ns), anchor_ns_(phase_ns) {}
 
   std::uint64_t OwnTickMicros(std::int64_t ns) {
-    std::uint64_t us = Micros(ns);
-    if (tick_hz_ != 0 && has_own_ && us < last_own_us_ + TickMicros()) {
-      us = last_own_us_ + TickMicros();
-    }
-    last_own_us_ = us;
+    if (tick_hz_ == 0) return static_cast<std::uint64_t>(ns / 1000);
+    std::int64_t index = Index(ns);
+    if (has_own_ && index < anchor_index_ + 1) index = anchor_index_ + 1;
+    anchor_ns_ = ns;
+    anchor_index_ = index;
     has_own_ = true;
-    return us;
+    return MicrosOf(index);
   }
   FDSURF_NODISCARD std::uint64_t StateMicros(std::int64_t ns) const {
-    const std::uint64_t us = Micros(ns);
-    return tick_hz_ != 0 && has_own_ && us < last_own_us_ ? last_own_us_ : us;
+    if (tick_hz_ == 0) return static_cast<std::uint64_t>(ns / 1000);
+    const std::int64_t index = Index(ns);
+    return MicrosOf(has_own_ && index < anchor_index_ ? anchor_index_ : index);
   }
 
  private:
-  FDSURF_NODISCARD std::uint64_t Micros(std::int64_t ns) const {
-    if (tick_hz_ == 0) return static_cast<std::uint64_t>(ns / 1000);
-    const double tick_ns = 1e9 / tick_hz_;
-    const double k = std::round(static_cast<double>(ns - phase_ns_) / tick_ns);
-    const double grid_ns = static_cast<double>(phase_ns_) + k * tick_ns;
+  FDSURF_NODISCARD double TickNs() const { return 1e9 / tick_hz_; }
+  // Grid ticks after the phase: the anchor's, plus the nearest whole number
+  // of ticks from the anchor's time.
+  FDSURF_NODISCARD std::int64_t Index(std::int64_t ns) const {
+    return anchor_index_ +
+           static_cast<std::int64_t>(std::round(static_cast<double>(ns - anchor_ns_) / TickNs()));
+  }
+  FDSURF_NODISCARD std::uint64_t MicrosOf(std::int64_t index) const {
+    const double grid_ns = static_cast<double>(phase_ns_) + static_cast<double>(index) * TickNs();
     return grid_ns <= 0 ? 0 : static_cast<std::uint64_t>(std::floor(grid_ns * 1e-3 + 1e-6));
   }
-  FDSURF_NODISCARD std::uint64_t TickMicros() const { return 1'000'000 / tick_hz_; }
 
   std::uint32_t tick_hz_;
   std::int64_t phase_ns_;
-  std::uint64_t last_own_us_ = 0;
+  std::int64_t anchor_ns_;
+  std::int64_t anchor_index_ = 0;
   bool has_own_ = false;
 };
 

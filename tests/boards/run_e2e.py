@@ -104,6 +104,12 @@ MICROBIT_LIMITS = [
     Limit("stack_high_water_bytes", ">=", 512, "the paint was read: the job used the stack"),
     Limit("stack margin", ">=", 1024, "1 KB of the stack space never touched",
           of=stack_margin("stack_high_water_bytes", "stack_space_bytes")),
+    # The servo's TIMER1 counts µs: its handler reaches the capture 1-2 µs
+    # after the compare; more means an edge waited for a masked section,
+    # which moves that pulse's width by as much.
+    Limit("servo_periods", ">=", 100, "the pen servo's 20 ms periods ran (2 s of them)"),
+    Limit("servo_max_lateness_us", "<=", 3,
+          "no servo edge delayed beyond its handler's entry (its width moved)"),
 ]
 
 # Per board: the baud of its UART, the step timing its drivers need (RAMPS:
@@ -121,8 +127,10 @@ BOARDS = {
                        "job_args": "--fit 20x15 --lines 2 --speed 20 "
                                    "--servo-pulse-up 1200 --servo-pulse-down 1800"},
     "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
-                    "servo_us": None, "limits": MICROBIT_LIMITS,
-                    "job_args": "--fit 40x30 --lines 2"},
+                    "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
+                    "limits": MICROBIT_LIMITS,
+                    "job_args": "--fit 40x30 --lines 2 "
+                                "--servo-pulse-up 1200 --servo-pulse-down 1800"},
     "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
                 "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 2"},
 }

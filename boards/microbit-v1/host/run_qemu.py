@@ -12,7 +12,8 @@ emulated board (the harness interface of docs/boards.md and the common brief):
   byte at --baud, paced by the guest's instruction clock, in bursts no larger
   than one poll of this loop); what the board sends goes to the client, or is
   dropped when there is none.
-- Records every change of the STEP/DIR/ENABLE/PEN pins with its emulated time
+- Records every change of the STEP/DIR/ENABLE pins and of the pen (the PEN
+  line, or the SERVO pin of a servo image) with its emulated time
   in OUT (waveform format 1), and exits 0 on SIGTERM/SIGINT or when the
   wall-clock time limit passes, after dumping the board's RAM through the
   QEMU monitor for the measures (--measures: a TSV of flash, RAM, stack
@@ -72,15 +73,17 @@ STATS_MAGIC = 0x5354424D
 STATS_FIELDS = ("magic tick_hz ticks late_ticks missed_ticks late_moving_ticks max_lateness max_tick_cycles "
                 "tick_cycles_low tick_cycles_high stepping_ticks max_stepping_tick_cycles "
                 "work_cycles_low work_cycles_high points max_work_cycles rx_bytes "
-                "rx_overruns uart_errors fault").split()
+                "rx_overruns uart_errors fault servo_periods servo_max_lateness_us").split()
 TIMER_HZ = 16_000_000
 
 # nRF51 GPIO -> waveform signals (src/pins.h). ENABLE is one line shared by
-# both drivers: it is written as X_EN and Y_EN.
+# both drivers: it is written as X_EN and Y_EN. The pen is PEN on P0.03 or,
+# in a servo image, SERVO on P0.02 (the image's fdsurf_board_pen says which).
 PIN_SIGNALS = {23: ("X_STEP",), 22: ("X_DIR",), 21: ("Y_STEP",), 16: ("Y_DIR",),
-               18: ("X_EN", "Y_EN"), 3: ("PEN",)}
+               18: ("X_EN", "Y_EN")}
+PEN_PIN, SERVO_PIN = 3, 2
 WAVEFORM_HEADER = ("# fdsurf-waveform 1\n# board microbit-v1\n# dir_negative_level 1\n"
-                   "# enable_active_level 0\n# pen line 1\n")
+                   "# enable_active_level 0\n")
 TRACE_RE = re.compile(r"nrf51_gpio_update_output_irq line (\d+) value (-?\d+)")
 
 
@@ -88,10 +91,18 @@ class Waveform:
     """Turns the QEMU log (trace lines, then the plugin's T line of the store
     that caused them) into waveform lines, incrementally."""
 
-    def __init__(self, path):
+    def __init__(self, path, pen):
+        """`pen`: the image's (kind, up_us, down_us), kind 0 a line, 1 a servo."""
         self.out = open(path + ".tmp", "w", encoding="ascii")
         self.path = path
-        self.out.write(WAVEFORM_HEADER)
+        self.pins = dict(PIN_SIGNALS)
+        if pen[0] == 1:
+            self.pins[SERVO_PIN] = ("SERVO",)
+            pen_line = f"# pen servo {pen[1]} {pen[2]}\n"
+        else:
+            self.pins[PEN_PIN] = ("PEN",)
+            pen_line = "# pen line 1\n"
+        self.out.write(WAVEFORM_HEADER + pen_line)
         self.levels = {}
         self.pending = []
         self.partial = ""
@@ -108,12 +119,12 @@ class Waveform:
                 self.end_count = int(line[4:])
             else:
                 match = TRACE_RE.search(line)
-                if match and int(match.group(1)) in PIN_SIGNALS and int(match.group(2)) >= 0:
+                if match and int(match.group(1)) in self.pins and int(match.group(2)) >= 0:
                     self.pending.append((int(match.group(1)), int(match.group(2))))
 
     def _stamp(self, count):
         for pin, level in self.pending:
-            for signal_name in PIN_SIGNALS[pin]:
+            for signal_name in self.pins[pin]:
                 if self.levels.get(signal_name) != level:
                     self.levels[signal_name] = level
                     self.changes[signal_name] += 1
@@ -151,8 +162,10 @@ class UartPacer:
         return out
 
 
-def elf_symbols_and_sizes(path):
-    """(symbols {name: value}, flash bytes, static RAM bytes) of an ELF32 LE."""
+def elf_symbols_and_sizes(path, read_words=None):
+    """(symbols {name: value}, flash bytes, static RAM bytes) of an ELF32 LE;
+    with `read_words` a symbol's name, also the 32-bit words of its initial
+    value (a tuple, as many as its size says; None if it is not in the ELF)."""
     data = open(path, "rb").read()
     if data[:4] != b"\x7fELF" or data[4] != 1 or data[5] != 1:
         raise SystemExit(f"run_qemu.py: {path}: not a 32-bit little-endian ELF file")
@@ -166,7 +179,7 @@ def elf_symbols_and_sizes(path):
         end = data.index(b"\0", table_offset + index)
         return data[table_offset + index:end].decode()
 
-    symbols, flash, ram = {}, 0, 0
+    symbols, sizes, flash, ram = {}, {}, 0, 0
     for name_index, kind, flags, addr, offset, size, link, _, _, entsize in sections:
         name = name_at(names_offset, name_index)
         if flags & 0x2:  # SHF_ALLOC
@@ -179,10 +192,31 @@ def elf_symbols_and_sizes(path):
         if kind == 2:  # SHT_SYMTAB
             strings = sections[link][4]
             for i in range(size // entsize):
-                st_name, st_value = struct.unpack_from("<II", data, offset + i * entsize)
+                st_name, st_value, st_size = struct.unpack_from("<III", data, offset + i * entsize)
                 if st_name:
                     symbols[name_at(strings, st_name)] = st_value
-    return symbols, flash, ram
+                    sizes[name_at(strings, st_name)] = st_size
+    if read_words is None:
+        return symbols, flash, ram
+    words = None
+    address, size = symbols.get(read_words), sizes.get(read_words, 0)
+    for _, kind, flags, addr, offset, section_size, _, _, _, _ in sections:
+        if address is not None and flags & 0x2 and kind != 8 and \
+                addr <= address and address + size <= addr + section_size:
+            words = struct.unpack_from(f"<{size // 4}I", data, offset + address - addr)
+    return symbols, flash, ram, words
+
+
+def image_pen(path):
+    """The image's pen (fdsurf_board_pen): (0, 0, 0) a line, (1, up, down) a
+    servo; an image without the symbol (before the servo) has a line."""
+    words = elf_symbols_and_sizes(path, "fdsurf_board_pen")[3]
+    if words is None:
+        return (0, 0, 0)
+    if len(words) != 3 or words[0] not in (0, 1):
+        raise SystemExit(f"run_qemu.py: {path}: fdsurf_board_pen is {words}, not "
+                         "(0, 0, 0) or (1, up_us, down_us)")
+    return words
 
 
 def build_plugin(directory):
@@ -265,7 +299,7 @@ class Harness:
         self.selector = selectors.DefaultSelector()
         self.client = None
         self.pacer = UartPacer(args.baud)
-        self.waveform = Waveform(args.waveform)
+        self.waveform = Waveform(args.waveform, image_pen(args.elf))
         self.log = None
         self.tx_bytes = 0
         self.clients = 0
@@ -439,6 +473,9 @@ def write_measures(args, harness, ram):
         ("rx_overruns", stats["rx_overruns"], "B", "dropped: ring full"),
         ("uart_errors", stats["uart_errors"], "", ""),
         ("fault", stats["fault"], "", "exception number, 0 = none"),
+        ("servo_periods", stats["servo_periods"], "", "pen servo periods started (0: a pen line)"),
+        ("servo_max_lateness_us", stats["servo_max_lateness_us"], "us",
+         "worst delay from a servo period's compare to its handler"),
         ("clients", harness.clients, "", ""),
     ]
     rows += [(f"changes_{name}", n, "", "") for name, n in sorted(harness.waveform.changes.items())]

@@ -2,9 +2,11 @@
 // The fdsurf plotter firmware on a BBC micro:bit v1 (nRF51822, Cortex-M0,
 // 16 MHz, 16 KB RAM): the protocol on UART0 (the interface chip's serial
 // pins, 115200 8N1, receive interrupt into a ring, polled send), the step
-// tick from TIMER0's compare interrupt, step/dir/enable/pen on edge-
-// connector pins (pins.h). The main loop only services the link and fills
-// the lookahead buffer; Device::Tick() runs in the timer interrupt.
+// tick from TIMER0's compare interrupt, step/dir/enable on edge-connector
+// pins (pins.h), the pen as a hobby servo's pulses from TIMER1 (servo_pwm.h)
+// or, built with FDSURF_MICROBIT_SERVO=0, as a line. The main loop only
+// services the link and fills the lookahead buffer; Device::Tick() runs in
+// the timer interrupt.
 #include <stddef.h>
 #include <stdint.h>
 
@@ -14,9 +16,20 @@
 #include "fdsurf/device/device.h"
 #include "nrf51.h"
 #include "pins.h"
+#include "servo_pwm.h"
 
 #ifndef FDSURF_MICROBIT_TICK_HZ
 #define FDSURF_MICROBIT_TICK_HZ 20000
+#endif
+// 1: the pen is a hobby servo on edge P1 (the default); 0: a line on P0.
+#ifndef FDSURF_MICROBIT_SERVO
+#define FDSURF_MICROBIT_SERVO 1
+#endif
+#ifndef FDSURF_MICROBIT_SERVO_UP_US
+#define FDSURF_MICROBIT_SERVO_UP_US 1000
+#endif
+#ifndef FDSURF_MICROBIT_SERVO_DOWN_US
+#define FDSURF_MICROBIT_SERVO_DOWN_US 2000
 #endif
 
 // Abstract HAL bases name it in their vtables; it is never called.
@@ -30,6 +43,11 @@ fdsurf::board::BoardStats fdsurf_board_stats;
 void fdsurf_board_main();
 void fdsurf_board_uart_irq();
 void fdsurf_board_timer_irq();
+void fdsurf_board_servo_irq();
+// The pen this image drives, for the QEMU harness (host/run_qemu.py reads it
+// from the ELF): {0, 0, 0} a line on pins::kPen, {1, up, down} a servo on
+// pins::kServo with the image's widths in µs.
+extern const uint32_t fdsurf_board_pen[3];
 }
 
 namespace fdsurf {
@@ -43,17 +61,49 @@ constexpr uint32_t kTickHz = FDSURF_MICROBIT_TICK_HZ;
 constexpr uint32_t kTickPeriod = nrf51::kTimerHz / kTickHz;
 static_assert(nrf51::kTimerHz % kTickHz == 0, "a whole number of 16 MHz counts per tick");
 
-/// Masks every interrupt (PRIMASK) while it lives, restoring the previous
-/// state: the Device's InterruptLock (fdsurf/device/device.h).
-class PrimaskLock {
+/// The pen servo's pulses for pen up and down (µs, every 20 ms), until a
+/// CONFIG gives others (hal::ServoPen).
+constexpr bool kServoPen = FDSURF_MICROBIT_SERVO != 0;
+constexpr uint16_t kServoUpUs = FDSURF_MICROBIT_SERVO_UP_US;
+constexpr uint16_t kServoDownUs = FDSURF_MICROBIT_SERVO_DOWN_US;
+static_assert(kServoUpUs >= hal::kServoMinPulseUs && kServoUpUs <= hal::kServoMaxPulseUs &&
+                  kServoDownUs >= hal::kServoMinPulseUs && kServoDownUs <= hal::kServoMaxPulseUs &&
+                  kServoUpUs != kServoDownUs,
+              "servo pulses from 500 to 2500 us, up and down different");
+
+// Interrupt priorities (0 highest): the servo's edges, then the step tick,
+// then the UART's receive (a byte waits in the 6-byte FIFO meanwhile). The
+// servo's handler is ~40 instructions twice per 20 ms, the only thing that
+// can delay a tick; a tick (up to ~460 cycles) could otherwise stretch a
+// servo pulse by ~30 µs.
+constexpr uint32_t kServoPriority = 0;
+constexpr uint32_t kTickPriority = 1;
+constexpr uint32_t kUartPriority = 2;
+
+/// Masks the step tick's and the UART's interrupts (TIMER0, UART0, in the
+/// NVIC) while it lives, restoring the previous state: the Device's
+/// InterruptLock (fdsurf/device/device.h). Not PRIMASK: the servo's
+/// interrupt must stay free to run, and a masked section (some take
+/// ~15 µs) would stretch or cut its pulse (the M0 has no BASEPRI). The UART
+/// is masked too, as PRIMASK did: its handler drains every byte QEMU has
+/// (a burst of dozens), which inside a section delayed a tick by 53 µs.
+/// dsb + isb: no instruction after the constructor runs before the mask.
+class TickLock {
  public:
-  PrimaskLock() { __asm__ volatile("mrs %0, primask\n\tcpsid i" : "=r"(saved_) : : "memory"); }
-  ~PrimaskLock() { __asm__ volatile("msr primask, %0" : : "r"(saved_) : "memory"); }
-  PrimaskLock(const PrimaskLock&) = delete;
-  PrimaskLock& operator=(const PrimaskLock&) = delete;
+  TickLock() : was_enabled_(nrf51::Reg(nrf51::kNvicIser) & kBits) {
+    nrf51::Reg(nrf51::kNvicIcer) = kBits;
+    __asm__ volatile("dsb\n\tisb" : : : "memory");
+  }
+  ~TickLock() {
+    __asm__ volatile("" : : : "memory");
+    nrf51::Reg(nrf51::kNvicIser) = was_enabled_;
+  }
+  TickLock(const TickLock&) = delete;
+  TickLock& operator=(const TickLock&) = delete;
 
  private:
-  uint32_t saved_;
+  static constexpr uint32_t kBits = (1u << nrf51::kTimerIrq) | (1u << nrf51::kUartIrq);
+  uint32_t was_enabled_;
 };
 
 /// Busy-waits about `loops` × 6 cycles on the M0 (2 nops, subs, a taken
@@ -164,12 +214,20 @@ constexpr int kLookahead = 256;
 // each loss a NAK or a timeout and a resend. 2 KB holds them all.
 constexpr uint16_t kRxRingBytes = 2048;
 using RxRing = ByteRing<kRxRingBytes, uint16_t>;
-using BoardDevice = device::Device<2, 8, kLookahead, PrimaskLock>;
+using BoardDevice = device::Device<2, 8, kLookahead, TickLock>;
 
 RxRing g_rx;
 BoardDevice g_device(kTickHz);
 PinOutputs g_outputs;
+TimerPwm g_servo_pwm(pins::kServo);
+hal::ServoPen g_servo_pen(g_servo_pwm, kServoUpUs, kServoDownUs);
 uint32_t g_next_compare;
+
+/// The pen Device::Tick() drives: the servo, or PinOutputs' PEN line.
+hal::PenOutput& Pen() {
+  if (kServoPen) return g_servo_pen;
+  return g_outputs;
+}
 
 uint32_t CaptureTimer(uint32_t channel) {
   Reg(nrf51::TimerTasksCapture(channel)) = 1;
@@ -210,8 +268,7 @@ void SetUpUart() {
   Reg(nrf51::kUartTasksStartRx) = 1;
   Reg(nrf51::kUartTasksStartTx) = 1;
   Reg(nrf51::kUartIntenSet) = nrf51::kUartIntRxdRdy | nrf51::kUartIntError;
-  // Below the step timer: a byte waits in the 6-byte FIFO meanwhile.
-  nrf51::EnableIrq(nrf51::kUartIrq, 1);
+  nrf51::EnableIrq(nrf51::kUartIrq, kUartPriority);
 }
 
 // Free-running 32-bit counter, CC[0] moved one period ahead at each tick:
@@ -226,7 +283,7 @@ void SetUpTimer() {
   Reg(nrf51::TimerCc(0)) = g_next_compare;
   Reg(nrf51::TimerEventsCompare(0)) = 0;
   Reg(nrf51::kTimerIntenSet) = nrf51::kTimerIntCompare0;
-  nrf51::EnableIrq(nrf51::kTimerIrq, 0);
+  nrf51::EnableIrq(nrf51::kTimerIrq, kTickPriority);
   Reg(nrf51::kTimerTasksStart) = 1;
 }
 
@@ -242,7 +299,7 @@ void ServiceOnce(hal::Transport& link) {
   BoardStats& stats = fdsurf_board_stats;
   uint32_t start, tick_cycles_before, entries_before, rx_before;
   {
-    const PrimaskLock lock;
+    const TickLock lock;
     start = CaptureTimer(2);
     tick_cycles_before = stats.tick_cycles_low;
     entries_before = g_device.motion().Count() + g_device.motion().moves();
@@ -250,7 +307,7 @@ void ServiceOnce(hal::Transport& link) {
   }
   (void)g_device.Service(link);
   g_device.Fill();
-  const PrimaskLock lock;
+  const TickLock lock;
   const uint32_t elapsed = CaptureTimer(2) - start - (stats.tick_cycles_low - tick_cycles_before);
   const uint32_t entries = g_device.motion().Count() + g_device.motion().moves() - entries_before;
   if (entries == 0 && stats.rx_bytes == rx_before) return;
@@ -305,7 +362,7 @@ void fdsurf_board_timer_irq() {
   if (lateness > stats.max_lateness) stats.max_lateness = lateness;
   g_outputs.Emit();  // the previous tick's outputs, at a fixed time after the compare
   const uint32_t moves = g_device.motion().moves();
-  (void)g_device.Tick(g_outputs, g_outputs);
+  (void)g_device.Tick(g_outputs, Pen());
   const uint32_t cycles = CaptureTimer(1) - entry;
   ++stats.ticks;
   AddCycles(&stats.tick_cycles_low, &stats.tick_cycles_high, cycles);
@@ -316,6 +373,17 @@ void fdsurf_board_timer_irq() {
   }
 }
 
+void fdsurf_board_servo_irq() {
+  using namespace fdsurf::board;
+  g_servo_pwm.OnInterrupt();
+  fdsurf_board_stats.servo_periods = g_servo_pwm.periods();
+  fdsurf_board_stats.servo_max_lateness_us = g_servo_pwm.max_lateness_us();
+}
+
+__attribute__((used)) const uint32_t fdsurf_board_pen[3] = {
+    fdsurf::board::kServoPen ? 1u : 0u, fdsurf::board::kServoPen ? fdsurf::board::kServoUpUs : 0u,
+    fdsurf::board::kServoPen ? fdsurf::board::kServoDownUs : 0u};
+
 void fdsurf_board_main() {
   using namespace fdsurf::board;
   fdsurf_board_stats.magic = kBoardStatsMagic;
@@ -324,6 +392,12 @@ void fdsurf_board_main() {
   SetUpClock();
   SetUpUart();
   UartTransport<RxRing, Uart> link(g_rx);
+  if (kServoPen) {
+    // Pen up from the first period on (hal::ServoPen::Start cannot fail on
+    // this PWM: 20 ms and the image's widths are within its range).
+    g_servo_pwm.Start(kServoPriority);
+    (void)g_servo_pen.Start();
+  }
   SetUpTimer();
   for (;;) ServiceOnce(link);
 }

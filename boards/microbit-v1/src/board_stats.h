@@ -55,6 +55,10 @@ struct BoardStats {
   uint32_t uart_errors;
   /// Non-zero once a fault handler ran (its exception number).
   uint32_t fault;
+  /// The pen servo (servo builds; 0 otherwise): periods started, and the
+  /// worst delay from a period's compare to its handler, µs (TIMER1 counts).
+  uint32_t servo_periods;
+  uint32_t servo_max_lateness_us;
 };
 
 }  // namespace board

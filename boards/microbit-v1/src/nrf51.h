@@ -61,6 +61,21 @@ constexpr uint32_t kTimerIntCompare0 = 1u << 16;
 constexpr uint32_t kTimerIrq = 8u;
 constexpr uint32_t kTimerHz = 16000000u;
 
+// TIMER1 (peripheral 9, interrupt 9): at most 16-bit on the nRF51 (TIMER0
+// alone counts 32 bits); the same register layout as TIMER0.
+constexpr uint32_t kTimer1 = 0x40009000u;
+constexpr uint32_t kTimer1TasksStart = kTimer1 + 0x000u;
+constexpr uint32_t kTimer1TasksClear = kTimer1 + 0x00Cu;
+inline constexpr uint32_t Timer1TasksCapture(uint32_t n) { return kTimer1 + 0x040u + 4u * n; }
+inline constexpr uint32_t Timer1EventsCompare(uint32_t n) { return kTimer1 + 0x140u + 4u * n; }
+inline constexpr uint32_t Timer1Cc(uint32_t n) { return kTimer1 + 0x540u + 4u * n; }
+constexpr uint32_t kTimer1IntenSet = kTimer1 + 0x304u;
+constexpr uint32_t kTimer1Mode = kTimer1 + 0x504u;
+constexpr uint32_t kTimer1Bitmode = kTimer1 + 0x508u;    // 0: 16 bit
+constexpr uint32_t kTimer1Prescaler = kTimer1 + 0x510u;  // 4: 1 MHz
+constexpr uint32_t kTimerIntCompare1 = 1u << 17;
+constexpr uint32_t kTimer1Irq = 9u;
+
 // GPIO (P0.00 .. P0.31).
 constexpr uint32_t kGpio = 0x50000000u;
 constexpr uint32_t kGpioOut = kGpio + 0x504u;
@@ -73,8 +88,9 @@ constexpr uint32_t kPinCnfOutput = 0x00000003u;
 // PIN_CNF: DIR input, input buffer connected, pull-up (the UART's RXD).
 constexpr uint32_t kPinCnfInputPullUp = 0x0000000Cu;
 
-// NVIC (ARMv6-M): set-enable, clear-pending, priority (2 bits, [7:6]).
+// NVIC (ARMv6-M): set-enable, clear-enable, clear-pending, priority (2 bits, [7:6]).
 constexpr uint32_t kNvicIser = 0xE000E100u;
+constexpr uint32_t kNvicIcer = 0xE000E180u;
 constexpr uint32_t kNvicIcpr = 0xE000E280u;
 inline constexpr uint32_t NvicIpr(uint32_t irq) { return 0xE000E400u + 4u * (irq / 4u); }
 

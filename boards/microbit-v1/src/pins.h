@@ -17,7 +17,8 @@ constexpr uint32_t kXDir = 22;    // edge P14
 constexpr uint32_t kYStep = 21;   // edge P15
 constexpr uint32_t kYDir = 16;    // edge P16
 constexpr uint32_t kEnable = 18;  // edge P8, shared by both drivers, active low
-constexpr uint32_t kPen = 3;      // edge P0 (the big ring), 1 = pen down
+constexpr uint32_t kPen = 3;      // edge P0 (the big ring), 1 = pen down (pen line build)
+constexpr uint32_t kServo = 2;    // edge P1 (big ring), the pen servo's pulses (servo build)
 
 // The UART to the interface chip (KL26Z), which the USB cable presents as
 // a CDC-ACM port (/dev/ttyACM0): the target's TX and RX.
@@ -28,7 +29,7 @@ constexpr uint32_t Bit(uint32_t pin) { return 1u << pin; }
 constexpr uint32_t kStepBits[2] = {Bit(kXStep), Bit(kYStep)};
 constexpr uint32_t kDirBits[2] = {Bit(kXDir), Bit(kYDir)};
 constexpr uint32_t kOutputBits =
-    Bit(kXStep) | Bit(kXDir) | Bit(kYStep) | Bit(kYDir) | Bit(kEnable) | Bit(kPen);
+    Bit(kXStep) | Bit(kXDir) | Bit(kYStep) | Bit(kYDir) | Bit(kEnable) | Bit(kPen) | Bit(kServo);
 
 /// The DIR level that means "towards negative" (waveform header), and the
 /// ENABLE level that energises the A4988/DRV8825 (active low).

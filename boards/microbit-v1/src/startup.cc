@@ -27,6 +27,7 @@ void fdsurf_board_fault();
 void fdsurf_board_main();
 void fdsurf_board_uart_irq();
 void fdsurf_board_timer_irq();
+void fdsurf_board_servo_irq();
 extern fdsurf::board::BoardStats fdsurf_board_stats;
 }
 
@@ -45,11 +46,15 @@ void fdsurf_board_reset() {
 }
 
 // Any fault or unexpected interrupt: release the motors (ENABLE is active
-// low), record the exception number, and stop.
+// low), lower the pen line and the servo pin, record the exception number, and stop.
 void fdsurf_board_fault() {
   __asm__ volatile("cpsid i" ::: "memory");
   using fdsurf::board::nrf51::Reg;
   Reg(fdsurf::board::nrf51::kGpioOutSet) = fdsurf::board::pins::Bit(fdsurf::board::pins::kEnable);
+  // No more servo pulses (its interrupt is masked now): the pin low, not
+  // stuck high; a PEN line goes up.
+  Reg(fdsurf::board::nrf51::kGpioOutClr) = fdsurf::board::pins::Bit(fdsurf::board::pins::kServo) |
+                                           fdsurf::board::pins::Bit(fdsurf::board::pins::kPen);
   uint32_t ipsr;
   __asm__ volatile("mrs %0, ipsr" : "=r"(ipsr));
   fdsurf_board_stats.fault = ipsr == 0 ? 0xFFu : ipsr;
@@ -59,7 +64,7 @@ void fdsurf_board_fault() {
 
 #define FAULT fdsurf_board_fault
 // Entry 0 is the initial stack pointer, 1 the reset handler, 2..15 the
-// system exceptions, then the nRF51 interrupts 0..31 (UART0 is 2, TIMER0 8).
+// system exceptions, then the nRF51 interrupts 0..31 (UART0 is 2, TIMER0 8, TIMER1 9).
 // The linker script keeps .vectors at address 0.
 // clang-format off
 __attribute__((section(".vectors"), used)) void (*const kVectorTable[16 + 32])() = {
@@ -68,7 +73,7 @@ __attribute__((section(".vectors"), used)) void (*const kVectorTable[16 + 32])()
     FAULT, FAULT, FAULT, FAULT, FAULT, FAULT, FAULT,          // 9 .. SysTick
     FAULT, FAULT, fdsurf_board_uart_irq, FAULT,               // POWER_CLOCK, RADIO, UART0, SPI0/TWI0
     FAULT, FAULT, FAULT, FAULT,                               // SPI1/TWI1, -, GPIOTE, ADC
-    fdsurf_board_timer_irq, FAULT, FAULT, FAULT,              // TIMER0, TIMER1, TIMER2, RTC0
+    fdsurf_board_timer_irq, fdsurf_board_servo_irq, FAULT, FAULT,  // TIMER0, TIMER1, TIMER2, RTC0
     FAULT, FAULT, FAULT, FAULT, FAULT, FAULT, FAULT, FAULT,   // 12 .. 19
     FAULT, FAULT, FAULT, FAULT, FAULT, FAULT, FAULT, FAULT,   // 20 .. 27
     FAULT, FAULT, FAULT, FAULT,                               // 28 .. 31
