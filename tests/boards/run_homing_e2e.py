@@ -20,6 +20,15 @@ anew (the board must keep its state between them: it is not reset):
    the back-off away from it, and nothing else; the harness's carriage says
    it ended at the back-off; the board started once (measures: boots 1).
 
+Scenario `hardlimit` instead starts the carriage 40 steps past its X min
+switch (the board counts 0 there, unhomed, as after a carriage pushed by
+hand), then `fdsurf machine goto 10 5` (away from the switch: allowed) and
+`fdsurf machine goto 0 0`: X reaches its switch at counted step 40 and the
+board stops there (kEndstopHit): exit 3 with "X min endstop hit during
+motion at step 40"; the recording shows X 200 steps out and exactly 160
+back, no step past the switch; `fdsurf machine where` then reports X at
+step 40, homed none.
+
 The expected step counts come from this driver's own parameters, not from
 the firmware. Every process runs under a timeout. Exit 0 pass, 1 fail.
 """
@@ -97,6 +106,35 @@ def check_recording(rec, starts, backoff_steps):
               "off %d" % (axis, start, backoff_steps))
 
 
+def hard_limit(args, processes, rec):
+    """Scenario hardlimit (the carriage started at --start -40,10)."""
+    code, output = machine(args, processes, "out", "goto", ["10", "5"], 60)
+    if code != 0:
+        raise Failure("goto 10 5 (away from the triggered switch) exited with %d: %s" %
+                      (code, output.strip()[-300:]))
+    code, output = machine(args, processes, "back", "goto", ["0", "0"], 60)
+    expected = ("X min endstop hit during motion at step 40: the position is lost; home the "
+                "machine (fdsurf machine home)")
+    if code != 3 or expected not in output:
+        raise Failure("goto 0 0 into the X switch: exit %d, expected 3 and %r in: %s" %
+                      (code, expected, output.strip()[-400:]))
+    print("run_homing_e2e: ok: the board stopped at the X switch: %s" % output.strip()[-160:])
+    code, output = machine(args, processes, "where", "where", [], 60)
+    if code != 0 or "(steps 40," not in output or "homed none" not in output:
+        raise Failure("fdsurf machine where after the hit said %r (exit %d): expected X at "
+                      "step 40, homed none" % (output.strip(), code))
+    time.sleep(0.3)
+    processes.stop("relay")
+    if processes.stop("harness") != 0:
+        raise Failure("the harness did not exit cleanly after SIGTERM")
+    _, transitions = run_e2e.read_transitions(rec)
+    runs = steps_by_direction(transitions, "X")
+    if runs != [(False, 200), (True, 160)]:
+        raise Failure("X's steps were %s (negative?, count), expected 200 out and 160 back "
+                      "to the switch, none past it" % runs)
+    print("run_homing_e2e: ok: X went 200 steps out and 160 back, none past its switch")
+
+
 def run(args, processes):
     work = processes.workdir
     rec = os.path.join(work, "rec.wave")
@@ -111,6 +149,8 @@ def run(args, processes):
     processes.start("relay", [sys.executable, args.relay, "--socket", sock, "--link",
                               args.link], 30)
     time.sleep(0.2)
+    if args.scenario == "hardlimit":
+        return hard_limit(args, processes, rec)
     refused_unhomed(args, processes)
     code, output = machine(args, processes, "home", "home",
                            ["--rate", str(RATE_MM_S), "--backoff", str(BACKOFF_MM)], 120)
@@ -146,12 +186,16 @@ def main():
     parser.add_argument("--relay", required=True)
     parser.add_argument("--job", required=True, help="a patch file (refused unhomed)")
     parser.add_argument("--elf", required=True)
-    parser.add_argument("--start", default="300,200",
-                        help="steps from each min switch at start, X,Y (default 300,200)")
+    parser.add_argument("--scenario", choices=("home", "hardlimit"), default="home")
+    parser.add_argument("--start",
+                        help="steps from each min switch at start, X,Y (default 300,200; "
+                             "hardlimit: -40,10)")
     parser.add_argument("--time-limit-s", type=int, default=200)
     parser.add_argument("--workdir", help="keep the files here (default: a temporary folder)")
     parser.add_argument("--harness", nargs=argparse.REMAINDER, required=True)
     args = parser.parse_args()
+    if args.start is None:
+        args.start = "-40,10" if args.scenario == "hardlimit" else "300,200"
     workdir = args.workdir or tempfile.mkdtemp(prefix="fdsurf-homing-e2e-")
     os.makedirs(workdir, exist_ok=True)
     processes = run_e2e.Processes(workdir)

@@ -339,7 +339,8 @@ TEST(HardLimitWithoutSwitches, TheSameJobRunsToTheEnd) {
   }
   protocol::StatusReport report{};
   device.FillStatus(&report);
-  ASSERT_TRUE(device.Idle()) << static_cast<int>(report.state) << " " << static_cast<int>(report.error);
+  ASSERT_TRUE(device.Idle()) << static_cast<int>(report.state) << " "
+                             << static_cast<int>(report.error);
   EXPECT_EQ(steps.position(0), 300);
   EXPECT_EQ(steps.position(1), 300);
 }

@@ -15,7 +15,7 @@
 // ticks, the main loop's cycles per emitted point, the painted stack's
 // high-water mark, flash and static RAM, as a TSV (host/README.md).
 // With --endstop-start: a simulated carriage on each axis, starting the
-// given number of steps above its min switch (X_MIN D3 = PE5, Y_MIN D14 =
+// given number of steps above its min switch (below 0: past it) (X_MIN D3 = PE5, Y_MIN D14 =
 // PJ1, Z_MIN D18 = PD3); every STEP pulse moves it one step (DIR high:
 // towards the switch), and the switch's input pin is driven to the
 // triggered level (default 1, the image's default for normally-closed
@@ -35,8 +35,8 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -80,7 +80,8 @@ struct Options {
   std::exit(2);
 }
 
-// "X,Y" or "X,Y,Z": whole numbers of steps, 0 or more.
+// "X,Y" or "X,Y,Z": whole numbers of steps (below 0: the carriage starts
+// past the switch's trigger point, as one pushed there by hand).
 std::vector<long> ParseStart(const std::string& value) {
   std::vector<long> steps;
   std::size_t begin = 0;
@@ -89,8 +90,8 @@ std::vector<long> ParseStart(const std::string& value) {
     const std::string field = value.substr(begin, comma - begin);
     char* end = nullptr;
     const long n = std::strtol(field.c_str(), &end, 10);
-    if (field.empty() || *end != 0 || n < 0) {
-      Usage("--endstop-start: '" + field + "' is not a whole number of steps, 0 or more");
+    if (field.empty() || *end != 0 || n < -1000000 || n > 1000000) {
+      Usage("--endstop-start: '" + field + "' is not a whole number of steps, -10^6..10^6");
     }
     steps.push_back(n);
     begin = comma + 1;
@@ -303,9 +304,8 @@ class Carriage {
   avr_t* avr_ = nullptr;
   int triggered_level_ = 1;
   // The RAMPS pins (ramps_outputs.h, ramps_inputs.h).
-  Axis axes_[3] = {{'X', 'F', 'F', 'E', 0, 1, 5},
-                   {'Y', 'F', 'F', 'J', 6, 7, 1},
-                   {'Z', 'L', 'L', 'D', 3, 1, 3}};
+  Axis axes_[3] = {
+      {'X', 'F', 'F', 'E', 0, 1, 5}, {'Y', 'F', 'F', 'J', 6, 7, 1}, {'Z', 'L', 'L', 'D', 3, 1, 3}};
 };
 
 void Carriage::Attach(avr_t* avr, const std::vector<long>& start, int triggered_level) {

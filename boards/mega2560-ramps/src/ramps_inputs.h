@@ -59,10 +59,10 @@ class RampsEndstops final : public hal::EndstopInputs {
     const uint8_t e = PINE;
     const uint8_t j = PINJ;
     const uint8_t d = kAxes == 3 ? PIND : 0;
-    uint8_t high_min = static_cast<uint8_t>((e >> PE5 & 1u) | (j >> PJ1 & 1u) << 1 |
-                                            (d >> PD3 & 1u) << 2);
-    uint8_t high_max = static_cast<uint8_t>((e >> PE4 & 1u) | (j >> PJ0 & 1u) << 1 |
-                                            (d >> PD2 & 1u) << 2);
+    uint8_t high_min =
+        static_cast<uint8_t>((e >> PE5 & 1u) | (j >> PJ1 & 1u) << 1 | (d >> PD3 & 1u) << 2);
+    uint8_t high_max =
+        static_cast<uint8_t>((e >> PE4 & 1u) | (j >> PJ0 & 1u) << 1 | (d >> PD2 & 1u) << 2);
     if (!kEndstopTriggeredHigh) {
       high_min = static_cast<uint8_t>(~high_min);
       high_max = static_cast<uint8_t>(~high_max);

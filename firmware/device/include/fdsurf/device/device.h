@@ -833,7 +833,8 @@ class Device {
     int32_t position[protocol::kMaxAxes];
     for (int a = 0; a < protocol::kMaxAxes; ++a) {
       position[a] = motion_.position()[a];
-      if ((out.step_mask >> a & 1u) != 0) position[a] += (out.negative_mask >> a & 1u) != 0 ? 1 : -1;
+      if ((out.step_mask >> a & 1u) != 0)
+        position[a] += (out.negative_mask >> a & 1u) != 0 ? 1 : -1;
     }
     motion_.set_position(position);
     uint8_t axis = 0;
