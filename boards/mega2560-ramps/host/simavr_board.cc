@@ -20,7 +20,8 @@
 // towards the switch), and the switch's input pin is driven to the
 // triggered level (default 1, the image's default for normally-closed
 // switches) at and below position 0, to the other level above it. Without
-// it, every min input is held at its released level. Each switch change and
+// it, every min input is held at its released level. The max inputs (X_MAX
+// D2 = PE4, Y_MAX D15 = PJ0, Z_MAX D19 = PD2) are always held released. Each switch change and
 // the carriage's final position go to stderr ("carriage ...").
 // Exits 0 on SIGTERM/SIGINT or at the time limit, having flushed OUT.
 #include <avr_ioport.h>
@@ -289,9 +290,10 @@ class Carriage {
   struct Axis {
     char name;
     char step_port, dir_port, min_port;
-    std::uint8_t step_bit, dir_bit, min_bit;
+    std::uint8_t step_bit, dir_bit, min_bit, max_bit;  // the max switch on min_port too
     avr_irq_t* dir = nullptr;
     avr_irq_t* min = nullptr;
+    avr_irq_t* max = nullptr;  // always released
     long position = 0;
     bool modelled = false;
     bool triggered = false;
@@ -320,6 +322,8 @@ void Carriage::Attach(avr_t* avr, const std::vector<long>& start, int triggered_
                               IOPORT_IRQ_PIN0 + axis->dir_bit);
     axis->min = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
                               IOPORT_IRQ_PIN0 + axis->min_bit);
+    axis->max = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
+                              IOPORT_IRQ_PIN0 + axis->max_bit);
     if (axis->modelled) {
       avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->step_port),
                                             IOPORT_IRQ_PIN0 + axis->step_bit),
@@ -349,12 +353,15 @@ void Carriage::Drive(Axis* axis) {
   }
   axis->triggered = triggered;
   avr_raise_irq(axis->min, triggered ? triggered_level_ : 1 - triggered_level_);
+  avr_raise_irq(axis->max, 1 - triggered_level_);
 }
 
 void Carriage::Reassert() {
   for (Axis& axis : axes_) {
     const std::uint32_t level = axis.triggered ? triggered_level_ : 1 - triggered_level_;
     if (axis.min->value != level) avr_raise_irq(axis.min, level);
+    const std::uint32_t released = 1 - triggered_level_;
+    if (axis.max->value != released) avr_raise_irq(axis.max, released);
   }
 }
 
