@@ -146,6 +146,18 @@ void ReadOneByteAtLeast(int fd) {
   (void)tcsetattr(fd, TCSANOW, &tio);
 }
 
+// No hang-up on close (HUPCL clear): DTR stays asserted when the port is
+// closed, so the next open raises no DTR edge and an Arduino that resets
+// on that edge (the Mega's auto-reset) keeps running, with its homing,
+// between two fdsurf commands. Only the first open after the board was
+// plugged in (DTR low until then) resets it.
+void KeepDtrAfterClose(int fd) {
+  termios tio{};
+  if (tcgetattr(fd, &tio) != 0) return;
+  tio.c_cflag &= ~static_cast<tcflag_t>(HUPCL);
+  (void)tcsetattr(fd, TCSANOW, &tio);
+}
+
 }  // namespace
 
 SerialTransport::SerialTransport(std::string path, const SerialOptions& options)
@@ -215,6 +227,7 @@ IoStatus SerialTransport::Attach(const std::string& node, std::string* error) {
   }
   (void)ioctl(fd, TIOCEXCL);
   ReadOneByteAtLeast(fd);
+  KeepDtrAfterClose(fd);
   (void)tcflush(fd, TCIOFLUSH);
   fd_ = fd;
   sp_port_ = port;

@@ -107,6 +107,21 @@ TEST_F(SerialPty, OpensRaw8N1WithoutFlowControlAtTheBaud) {
   EXPECT_EQ(cfgetospeed(&tio), static_cast<speed_t>(B57600));
 }
 
+// A serial port starts with HUPCL set (the kernel's standard termios; a
+// pty does not, so the test sets it); the port clears it so that closing it
+// keeps DTR up and an Arduino is not reset by the next fdsurf's open.
+TEST_F(SerialPty, ClosingKeepsDtrUpSoTheNextOpenDoesNotResetAnArduino) {
+  termios before{};
+  ASSERT_EQ(tcgetattr(pty_.slave, &before), 0);
+  before.c_cflag |= HUPCL;
+  ASSERT_EQ(tcsetattr(pty_.slave, TCSANOW, &before), 0);
+  auto port = OpenOk(115200);
+  ASSERT_TRUE(port);
+  termios tio{};
+  ASSERT_EQ(tcgetattr(pty_.slave, &tio), 0);
+  EXPECT_EQ(tio.c_cflag & HUPCL, 0u);
+}
+
 TEST_F(SerialPty, MovesEveryByteValueBothWays) {
   auto port = OpenOk();
   ASSERT_TRUE(port);

@@ -2,8 +2,9 @@
 // HOME and MOTORS on the firmware's Device against the simulated endstops
 // (hal/sim_endstops.h): where homing leaves the machine, the search at the
 // commanded rate, kHomingFailed when a switch never triggers or never
-// releases, kNotHomed while a configuration requires homing, and MOTORS 0
-// forgetting it. Then the same through the simulated plotter and the host link.
+// releases, kNotHomed while a configuration requires homing, MOTORS 0
+// forgetting it, and the switches as hard limits outside HOME (kEndstopHit).
+// Then the same through the simulated plotter and the host link.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -269,6 +270,96 @@ TEST(HomingWithoutEndstops, HomeIsRefusedAndNoFeatureIsReported) {
   EXPECT_EQ(detail, protocol::kHomeFieldAxes);
 }
 
+// A carriage 100 steps further down than the device believes: its X min
+// switch is triggered at counted X <= 100. It starts on the switch (real
+// X -100); moving away is allowed, coming back is not.
+class OffsetCarriageTest : public HomingTest {
+ protected:
+  static hal::SimEndstopOptions Offset() {
+    hal::SimEndstopOptions options;
+    options.start_offset[0] = -100;
+    options.start_offset[1] = 50;
+    options.min_switches = 0x03;
+    return options;
+  }
+  OffsetCarriageTest() : HomingTest(Offset()) {}
+};
+
+// Four commands: the fixture's queue holds four.
+std::vector<protocol::Command> OutAndBack() {
+  return {MoveCommand(1000, 500), PenCommand(true), MoveCommand(0, 0), MoveCommand(300, 300)};
+}
+
+TEST_F(OffsetCarriageTest, AMoveIntoATriggeredMinSwitchStopsAtOnceAndFaults) {
+  AcceptAll({ConfigCommand(), HomeCommand(0x02, 0, 2000, 0)});  // Y homed, resting on its switch
+  ASSERT_TRUE(Run());
+  ASSERT_EQ(Status().flags & 0x06, 0x04);
+  AcceptAll(OutAndBack());
+  ASSERT_TRUE(Run());
+  const protocol::StatusReport report = Status();
+  ASSERT_EQ(report.state, protocol::DeviceState::kFault);
+  EXPECT_EQ(report.error, protocol::ErrorCode::kEndstopHit);
+  EXPECT_EQ(report.error_detail, 0);  // X, min switch
+  // No step into the switch: the carriage is exactly on it, and the
+  // reported position is the steps made.
+  EXPECT_EQ(endstops_.real_position(0), 0);
+  EXPECT_EQ(steps_.position(0), 100);
+  EXPECT_EQ(report.position[0], 100);
+  EXPECT_EQ(report.position[1], steps_.position(1) + 50);  // homing counted Y from the switch
+  EXPECT_FALSE(pen_.down());
+  EXPECT_EQ(report.flags & 0x06, 0);  // homing forgotten
+  // The rest of the job was dropped: ticks go by, nothing moves.
+  const std::int64_t y = steps_.position(1);
+  for (int t = 0; t < 1000; ++t) {
+    device_.Fill();
+    ASSERT_EQ(device_.Tick(steps_, pen_), hal::IoStatus::kOk);
+  }
+  EXPECT_EQ(steps_.position(0), 100);
+  EXPECT_EQ(steps_.position(1), y);
+  EXPECT_EQ(Status().queued, 0);
+}
+
+// The mutation side: the same job on a device without switches runs to the
+// end, through where the switch would be.
+TEST(HardLimitWithoutSwitches, TheSameJobRunsToTheEnd) {
+  hal::SimClock clock;
+  hal::SimStepDir steps(clock, 2);
+  hal::SimPen pen(clock);
+  device::Device<2, 4, 256> device(kTickHz);
+  std::uint8_t detail = 0;
+  ASSERT_EQ(device.Accept(ConfigCommand(), &detail), protocol::ErrorCode::kNone);
+  device.Fill();
+  for (const protocol::Command& command : OutAndBack()) {
+    ASSERT_EQ(device.Accept(command, &detail), protocol::ErrorCode::kNone);
+  }
+  for (int t = 0; t < 4'000'000 && !device.Idle(); ++t) {
+    device.Fill();
+    ASSERT_EQ(device.Tick(steps, pen), hal::IoStatus::kOk);
+    clock.Advance(1'000'000 / kTickHz);
+  }
+  protocol::StatusReport report{};
+  device.FillStatus(&report);
+  ASSERT_TRUE(device.Idle()) << static_cast<int>(report.state) << " "
+                             << static_cast<int>(report.error);
+  EXPECT_EQ(steps.position(0), 300);
+  EXPECT_EQ(steps.position(1), 300);
+}
+
+TEST_F(OffsetCarriageTest, AMaxSwitchStopsMotionTowardsIt) {
+  hal::SimEndstopOptions options = Offset();
+  options.travel[0] = 1100;  // the X max switch at counted X >= 1200
+  hal::SimEndstops switches(steps_, options);
+  device_.set_endstops(&switches);
+  AcceptAll({ConfigCommand(), MoveCommand(1500, 0)});
+  ASSERT_TRUE(Run());
+  const protocol::StatusReport report = Status();
+  ASSERT_EQ(report.state, protocol::DeviceState::kFault);
+  EXPECT_EQ(report.error, protocol::ErrorCode::kEndstopHit);
+  EXPECT_EQ(report.error_detail, protocol::kEndstopHitMax);  // X, max switch
+  EXPECT_EQ(steps_.position(0), 1200);
+  EXPECT_EQ(report.position[0], 1200);
+}
+
 // Through the protocol: the host link's job CONFIG, HOME, MOVE on the
 // simulated plotter with its switches.
 TEST(SimulatedPlotterHoming, HomesThroughTheLink) {
@@ -288,6 +379,26 @@ TEST(SimulatedPlotterHoming, HomesThroughTheLink) {
   EXPECT_EQ(plotter.endstops()->real_position(1), 508);
   ASSERT_TRUE(link.status().has_value());
   EXPECT_EQ(link.status()->flags & 0x06, 0x06);
+}
+
+// The host's words for a hard limit: axis, end, step, and what to do.
+TEST(SimulatedPlotterHoming, AnEndstopHitFailsTheJobWithAClearMessage) {
+  sim::PlotterOptions options;
+  options.endstops = true;
+  options.endstop_options.start_offset[0] = -100;
+  options.endstop_options.start_offset[1] = 50;
+  options.endstop_options.min_switches = 0x03;
+  sim::SimulatedPlotter plotter(options);
+  host::HostLink link;
+  ASSERT_TRUE(link.Enqueue(ConfigCommand()).ok());
+  for (const protocol::Command& command : OutAndBack()) ASSERT_TRUE(link.Enqueue(command).ok());
+  const sim::RunResult result = plotter.Run(link, 60'000'000);
+  ASSERT_FALSE(result.finished);
+  EXPECT_NE(result.error.find("X min endstop hit during motion at step 100: the position is "
+                              "lost; home the machine (fdsurf machine home)"),
+            std::string::npos)
+      << result.error;
+  EXPECT_EQ(plotter.endstops()->real_position(0), 0);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 //
 //   fdsurf_simavr_board --elf IMAGE.elf --uart-socket PATH --waveform OUT
 //                       [--time-limit-s N] [--measures OUT.tsv] [--speed realtime|max]
+//                       [--endstop-start X,Y[,Z]] [--endstop-triggered-level 1|0]
 //
 // UART0 is bridged to a Unix-domain stream socket at PATH (one client at a
 // time; the next is accepted when it leaves). Received bytes enter simavr's
@@ -13,6 +14,15 @@
 // ns (waveform format 1). With --measures: the step interrupt's cycles, late
 // ticks, the main loop's cycles per emitted point, the painted stack's
 // high-water mark, flash and static RAM, as a TSV (host/README.md).
+// With --endstop-start: a simulated carriage on each axis, starting the
+// given number of steps above its min switch (below 0: past it) (X_MIN D3 = PE5, Y_MIN D14 =
+// PJ1, Z_MIN D18 = PD3); every STEP pulse moves it one step (DIR high:
+// towards the switch), and the switch's input pin is driven to the
+// triggered level (default 1, the image's default for normally-closed
+// switches) at and below position 0, to the other level above it. Without
+// it, every min input is held at its released level. The max inputs (X_MAX
+// D2 = PE4, Y_MAX D15 = PJ0, Z_MAX D19 = PD2) are always held released. Each switch change and
+// the carriage's final position go to stderr ("carriage ...").
 // Exits 0 on SIGTERM/SIGINT or at the time limit, having flushed OUT.
 #include <avr_ioport.h>
 #include <avr_uart.h>
@@ -26,6 +36,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -56,15 +67,38 @@ struct Options {
   std::string measures;
   double time_limit_s = 0;  // 0: none
   bool realtime = true;
+  std::vector<long> endstop_start;  // steps above each min switch; empty: no carriage
+  int triggered_level = 1;
 };
 
 [[noreturn]] void Usage(const std::string& why) {
   std::fprintf(stderr,
                "fdsurf_simavr_board: %s\nusage: fdsurf_simavr_board --elf IMAGE.elf "
                "--uart-socket PATH --waveform OUT [--time-limit-s N] [--measures OUT.tsv] "
-               "[--speed realtime|max]\n",
+               "[--speed realtime|max] [--endstop-start X,Y[,Z]] "
+               "[--endstop-triggered-level 1|0]\n",
                why.c_str());
   std::exit(2);
+}
+
+// "X,Y" or "X,Y,Z": whole numbers of steps (below 0: the carriage starts
+// past the switch's trigger point, as one pushed there by hand).
+std::vector<long> ParseStart(const std::string& value) {
+  std::vector<long> steps;
+  std::size_t begin = 0;
+  while (begin <= value.size()) {
+    const std::size_t comma = std::min(value.find(',', begin), value.size());
+    const std::string field = value.substr(begin, comma - begin);
+    char* end = nullptr;
+    const long n = std::strtol(field.c_str(), &end, 10);
+    if (field.empty() || *end != 0 || n < -1000000 || n > 1000000) {
+      Usage("--endstop-start: '" + field + "' is not a whole number of steps, -10^6..10^6");
+    }
+    steps.push_back(n);
+    begin = comma + 1;
+  }
+  if (steps.size() < 2 || steps.size() > 3) Usage("--endstop-start: X,Y or X,Y,Z");
+  return steps;
 }
 
 Options ParseOptions(int argc, char** argv) {
@@ -87,6 +121,11 @@ Options ParseOptions(int argc, char** argv) {
       if (end == value.c_str() || *end != 0 || !(o.time_limit_s > 0)) {
         Usage("--time-limit-s: '" + value + "' is not a positive number of seconds");
       }
+    } else if (arg == "--endstop-start") {
+      o.endstop_start = ParseStart(value);
+    } else if (arg == "--endstop-triggered-level") {
+      if (value != "0" && value != "1") Usage("--endstop-triggered-level: 0 or 1");
+      o.triggered_level = value == "1" ? 1 : 0;
     } else if (arg == "--speed") {
       if (value != "realtime" && value != "max") Usage("--speed: realtime or max");
       o.realtime = value == "realtime";
@@ -235,6 +274,105 @@ void UartBridge::Close() {
   listen_fd_ = -1;
 }
 
+// --- The carriage and its min switches --------------------------------------
+
+class Carriage {
+ public:
+  /// Drives every min input to its level; with `start` empty the switches
+  /// stay released and nothing moves.
+  void Attach(avr_t* avr, const std::vector<long>& start, int triggered_level);
+  /// Drives the inputs again (the firmware's own PORT writes cannot have
+  /// changed what the switch says for longer than a slice).
+  void Reassert();
+  void Report() const;
+
+ private:
+  struct Axis {
+    char name;
+    char step_port, dir_port, min_port;
+    std::uint8_t step_bit, dir_bit, min_bit, max_bit;  // the max switch on min_port too
+    avr_irq_t* dir = nullptr;
+    avr_irq_t* min = nullptr;
+    avr_irq_t* max = nullptr;  // always released
+    long position = 0;
+    bool modelled = false;
+    bool triggered = false;
+    std::uint32_t step_level = 0;
+    Carriage* carriage = nullptr;
+  };
+  static void OnStep(avr_irq_t* irq, std::uint32_t value, void* param);
+  void Drive(Axis* axis);
+
+  avr_t* avr_ = nullptr;
+  int triggered_level_ = 1;
+  // The RAMPS pins (ramps_outputs.h, ramps_inputs.h).
+  Axis axes_[3] = {
+      {'X', 'F', 'F', 'E', 0, 1, 5}, {'Y', 'F', 'F', 'J', 6, 7, 1}, {'Z', 'L', 'L', 'D', 3, 1, 3}};
+};
+
+void Carriage::Attach(avr_t* avr, const std::vector<long>& start, int triggered_level) {
+  avr_ = avr;
+  triggered_level_ = triggered_level;
+  for (std::size_t a = 0; a < 3; ++a) {
+    Axis* axis = &axes_[a];
+    axis->carriage = this;
+    axis->modelled = a < start.size();
+    axis->position = axis->modelled ? start[a] : 1;
+    axis->dir = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->dir_port),
+                              IOPORT_IRQ_PIN0 + axis->dir_bit);
+    axis->min = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
+                              IOPORT_IRQ_PIN0 + axis->min_bit);
+    axis->max = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
+                              IOPORT_IRQ_PIN0 + axis->max_bit);
+    if (axis->modelled) {
+      avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->step_port),
+                                            IOPORT_IRQ_PIN0 + axis->step_bit),
+                              OnStep, axis);
+    }
+    Drive(axis);
+  }
+}
+
+// A rising STEP edge moves the carriage one step; DIR high is negative.
+void Carriage::OnStep(avr_irq_t*, std::uint32_t value, void* param) {
+  auto* axis = static_cast<Axis*>(param);
+  const std::uint32_t level = value & 1u;
+  const bool rising = level == 1 && axis->step_level == 0;
+  axis->step_level = level;
+  if (!rising) return;
+  axis->position += (axis->dir->value & 1u) != 0 ? -1 : 1;
+  axis->carriage->Drive(axis);
+}
+
+void Carriage::Drive(Axis* axis) {
+  const bool triggered = axis->modelled && axis->position <= 0;
+  if (triggered != axis->triggered) {
+    std::fprintf(stderr, "fdsurf_simavr_board: %c min switch %s at position %ld, %.6f s\n",
+                 axis->name, triggered ? "triggered" : "released", axis->position,
+                 static_cast<double>(avr_->cycle) / kCpuHz);
+  }
+  axis->triggered = triggered;
+  avr_raise_irq(axis->min, triggered ? triggered_level_ : 1 - triggered_level_);
+  avr_raise_irq(axis->max, 1 - triggered_level_);
+}
+
+void Carriage::Reassert() {
+  for (Axis& axis : axes_) {
+    const std::uint32_t level = axis.triggered ? triggered_level_ : 1 - triggered_level_;
+    if (axis.min->value != level) avr_raise_irq(axis.min, level);
+    const std::uint32_t released = 1 - triggered_level_;
+    if (axis.max->value != released) avr_raise_irq(axis.max, released);
+  }
+}
+
+void Carriage::Report() const {
+  std::fprintf(stderr, "fdsurf_simavr_board: carriage");
+  for (const Axis& axis : axes_) {
+    if (axis.modelled) std::fprintf(stderr, " %c %ld", axis.name, axis.position);
+  }
+  std::fprintf(stderr, "\n");
+}
+
 // --- Running ---------------------------------------------------------------
 
 struct Emulator {
@@ -264,7 +402,7 @@ std::uint64_t NowNs() {
 }
 
 // Runs until a signal, the time limit or a crash; true unless it crashed.
-bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge) {
+bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge, Carriage* carriage) {
   avr_t* avr = emulator->avr;
   const std::uint64_t limit =
       o.time_limit_s > 0 ? static_cast<std::uint64_t>(o.time_limit_s * kCpuHz) : UINT64_MAX;
@@ -281,6 +419,7 @@ bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge) {
       }
     }
     bridge->Service();
+    carriage->Reassert();
     if (o.realtime) {
       // Never ahead of the wall clock: the host's timeouts are wall time.
       const std::uint64_t emulated_ns = avr->cycle * 125 / 2;
@@ -312,6 +451,8 @@ int main(int argc, char** argv) {
   recorder.Attach(emulator.avr);
   UartBridge bridge;
   bridge.Attach(emulator.avr);
+  Carriage carriage;
+  carriage.Attach(emulator.avr, o.endstop_start, o.triggered_level);
   if (!bridge.Listen(o.socket_path, &error)) {
     std::fprintf(stderr, "fdsurf_simavr_board: --uart-socket %s\n", error.c_str());
     return 2;
@@ -321,8 +462,9 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   std::fputs("ready\n", out);
   std::fflush(out);
-  const bool ok = RunLoop(o, &emulator, &bridge);
+  const bool ok = RunLoop(o, &emulator, &bridge, &carriage);
   bridge.Close();
+  if (!o.endstop_start.empty()) carriage.Report();
   recorder.Finish(emulator.avr);
   if (!o.measures.empty()) {
     fdsurf::board::ImageFacts facts{emulator.firmware.flashsize, emulator.firmware.datasize,

@@ -21,6 +21,12 @@
 #ifndef FDSURF_MEGA_SERVO_DOWN_US
 #define FDSURF_MEGA_SERVO_DOWN_US 2000
 #endif
+#ifndef FDSURF_MEGA_MAX_ENDSTOPS
+#define FDSURF_MEGA_MAX_ENDSTOPS 0
+#endif
+#ifndef FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH
+#define FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH 1
+#endif
 
 namespace fdsurf {
 namespace mega {
@@ -45,6 +51,18 @@ constexpr uint16_t kServoDownUs = FDSURF_MEGA_SERVO_DOWN_US;
 static_assert(kServoUpUs >= 500 && kServoUpUs <= 2500 && kServoDownUs >= 500 &&
                   kServoDownUs <= 2500,
               "servo pulses from 500 to 2500 us");
+
+/// The endstops (ramps_inputs.h): the min switches are always read; the
+/// max ones (X_MAX D2, Y_MAX D15, Z_MAX D19) only when this is 1.
+constexpr bool kMaxEndstops = FDSURF_MEGA_MAX_ENDSTOPS != 0;
+static_assert(FDSURF_MEGA_MAX_ENDSTOPS == 0 || FDSURF_MEGA_MAX_ENDSTOPS == 1,
+              "FDSURF_MEGA_MAX_ENDSTOPS: 0 or 1");
+/// 1: a HIGH input (pull-up, switch open) is "triggered", for normally-
+/// closed switches to GND (the default: a broken wire stops the axis);
+/// 0: LOW is triggered, for normally-open switches to GND.
+constexpr bool kEndstopTriggeredHigh = FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH != 0;
+static_assert(FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH == 0 || FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH == 1,
+              "FDSURF_MEGA_ENDSTOP_TRIGGERED_HIGH: 0 or 1");
 
 /// Device sizes: commands that can wait (the host's credit) and unit moves
 /// buffered ahead of the motion. They and the validation's stack share the

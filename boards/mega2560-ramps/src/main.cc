@@ -14,6 +14,7 @@
 #include "fdsurf/board/byte_ring.h"
 #include "fdsurf/board/uart_transport.h"
 #include "fdsurf/device/device.h"
+#include "ramps_inputs.h"
 #include "ramps_outputs.h"
 
 extern "C" {
@@ -67,6 +68,7 @@ board::UartTransport<board::ByteRing<kRxRing>, Uart0> g_link(g_rx);
 device::Device<kAxes, kQueueCapacity, kLookahead, TickInterruptLock> g_device(kTickHz);
 RampsSteppers g_steppers;
 ServoPen g_pen;
+RampsEndstops g_endstops;
 volatile uint16_t g_ticks_since_heartbeat = 0;
 volatile bool g_in_service = false;
 /// MCUSR at reset (why the board started), saved by SaveResetCause().
@@ -163,6 +165,8 @@ int main() {
   using namespace fdsurf::mega;
   g_reset_cause = GPIOR0;
   SetSafeOutputs();
+  SetUpEndstopPins();
+  g_device.set_endstops(&g_endstops);
   PaintFreeRam();
   StartUart();
   StartStepTimer();

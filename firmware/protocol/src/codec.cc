@@ -687,6 +687,8 @@ const char* ErrorName(ErrorCode code) {
       return "not homed";
     case ErrorCode::kHomingFailed:
       return "homing failed";
+    case ErrorCode::kEndstopHit:
+      return "endstop hit";
   }
   return "unknown error";
 }

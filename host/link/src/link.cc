@@ -266,15 +266,29 @@ void HostLink::HandleReply(const protocol::Reply& reply, uint64_t now_us) {
         waiting_for_rest_ = false;  // at rest (or running): try again
       }
       Acknowledge(status_->next_seq, status_->credits, now_us);
-      if (status_->state == protocol::DeviceState::kFault) {
-        Fail("device fault: " + std::string(protocol::ErrorName(status_->error)) + " (detail " +
-             std::to_string(status_->error_detail) + ")");
-      }
+      if (status_->state == protocol::DeviceState::kFault) Fail(FaultMessage(*status_));
       return;
     }
     default:
       return;
   }
+}
+
+std::string HostLink::FaultMessage(const protocol::StatusReport& status) {
+  if (status.error == protocol::ErrorCode::kEndstopHit) {
+    // The axis and which end, and where it stopped: the position the
+    // device reports is the last step it made.
+    const unsigned axis = status.error_detail & 3u;
+    if (axis < protocol::kMaxAxes) {
+      const bool max = (status.error_detail & protocol::kEndstopHitMax) != 0;
+      return std::string("device fault: ") + "XYZ"[axis] + (max ? " max" : " min") +
+             " endstop hit during motion at step " + std::to_string(status.position[axis]) +
+             ": the position is lost; home the machine (fdsurf machine home) before the next "
+             "job";
+    }
+  }
+  return "device fault: " + std::string(protocol::ErrorName(status.error)) + " (detail " +
+         std::to_string(status.error_detail) + ")";
 }
 
 void HostLink::HandleHelloReply(const protocol::Reply& reply, uint64_t now_us) {

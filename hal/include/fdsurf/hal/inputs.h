@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Input-only hardware: the endstop switches at the ends of each axis's
-// travel. The firmware polls them in its step tick (Device::Tick) while it
-// homes, and reports them in STATUS; nothing here interrupts or blocks.
+// travel. The firmware polls them in its step tick (Device::Tick): it homes
+// against them, stops motion that runs into one (a hard limit, kEndstopHit),
+// and reports them in STATUS; nothing here interrupts or blocks.
 //
 // Pigweed style, as outputs.h: non-virtual public methods call private pure
 // virtual Do...() methods; the destructor is protected and non-virtual.

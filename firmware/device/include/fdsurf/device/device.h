@@ -38,6 +38,14 @@
 // accumulator: one addition and one comparison per tick, no division), backs
 // off, and sets the axis's position; the path generator and its travel
 // checks are not involved. MOTORS 0 disables the drivers and forgets homing.
+// Outside HOME the switches are hard limits (as Grbl's): when a unit move
+// would step an axis towards a switch that is triggered (its min switch
+// moving negative, its max switch moving positive), Tick() makes no step,
+// lifts the pen, forgets homing and faults (kEndstopHit); the next Fill()
+// drops the queue and the buffer. No deceleration: the carriage is at its
+// mechanical end. Motion away from a triggered switch is allowed (homing
+// with no back-off leaves the carriage on it). The check is two ANDs of the
+// masks the tick read anyway.
 // A configuration with kConfigFlagHomingRequired makes Accept() refuse
 // PATCH, CURVE and MOVE (kNotHomed) unless every axis will be homed by the
 // time they run (a HOME accepted before them counts).
@@ -127,6 +135,7 @@ class Device {
   /// device whose motion consumes entries faster than it expands them (an
   /// 8-bit MCU) still gets back to Service() and answers the host.
   void Fill(uint16_t max_entries = 0xFFFFu) {
+    FinishEndstopHit();
     FinishStopAtRest();
     if (!FinishHomingAtRest()) return;
     for (uint16_t pushed = 0; pushed < max_entries;) {
@@ -182,7 +191,9 @@ class Device {
   hal::IoStatus Tick(hal::StepDirOutputs& steppers, hal::PenOutput& pen) {
     // After a fault the motion still comes to rest along its path and the
     // pen is lifted, unless the outputs themselves failed.
-    if (outputs_failed_ || (fault_ && motion_.Idle())) return hal::IoStatus::kOk;
+    if (outputs_failed_ || endstop_hit_ || (fault_ && motion_.Idle())) {
+      return hal::IoStatus::kOk;
+    }
     if (pen_config_pending_) {
       // A CONFIG took effect (the motion at rest): the pen's servo widths.
       pen_config_pending_ = false;
@@ -205,6 +216,11 @@ class Device {
     const motion::TickOutput out = motion_.Tick();
     executed_ += out.commands_done;
     if (out.pen != 0) status = pen.SetPen(out.pen > 0);
+    // Towards a triggered switch: min while negative, max while positive.
+    const uint8_t hit = static_cast<uint8_t>(
+        out.step_mask & ((out.negative_mask & endstops_now_.min_mask) |
+                         (static_cast<uint8_t>(~out.negative_mask) & endstops_now_.max_mask)));
+    if (hit != 0) return EndstopHit(out, hit, pen);
     if (status == hal::IoStatus::kOk && out.step_mask != 0) {
       if (!enabled_) {
         status = steppers.SetEnabled(true);
@@ -439,6 +455,7 @@ class Device {
     accepted_homed_ = 0;
     motors_request_ = kNoMotorsRequest;
     homing_ = Homing{};
+    endstop_hit_ = false;
     endstops_now_ = hal::EndstopState{0, 0};
     for (int32_t& travel : applied_travel_) travel = 0;
     generator_.Reset(motion_.position(), false);
@@ -807,6 +824,47 @@ class Device {
     return hal::IoStatus::kOk;
   }
 
+  // In Tick(): the unit move `out` would step the axes in `hit` towards
+  // their triggered switches. None of its steps is made (the loop's
+  // position is put back), the pen goes up at once, homing is forgotten;
+  // Tick() then does nothing until Fill() has dropped the motion
+  // (FinishEndstopHit). The lowest axis hit is reported.
+  hal::IoStatus EndstopHit(const motion::TickOutput& out, uint8_t hit, hal::PenOutput& pen) {
+    int32_t position[protocol::kMaxAxes];
+    for (int a = 0; a < protocol::kMaxAxes; ++a) {
+      position[a] = motion_.position()[a];
+      if ((out.step_mask >> a & 1u) != 0)
+        position[a] += (out.negative_mask >> a & 1u) != 0 ? 1 : -1;
+    }
+    motion_.set_position(position);
+    uint8_t axis = 0;
+    while ((hit >> axis & 1u) == 0) ++axis;
+    const bool max = (out.negative_mask >> axis & 1u) == 0;
+    endstop_hit_ = true;
+    fault_ = true;
+    error_ = protocol::ErrorCode::kEndstopHit;
+    error_detail_ = static_cast<uint8_t>(axis | (max ? protocol::kEndstopHitMax : 0));
+    homed_ = 0;
+    EndPause();
+    const hal::IoStatus lifted = pen.SetPen(false);
+    return lifted == hal::IoStatus::kOk ? lifted : OutputFailed(lifted);
+  }
+
+  // In the main loop after an endstop hit: as HALT, the queue and the buffer
+  // go at once and the loop's pen state follows through a pen-up entry
+  // (the pen itself is up already); a homing accepted but not run is void.
+  void FinishEndstopHit() {
+    {
+      const InterruptLock lock;
+      if (!endstop_hit_) return;
+    }
+    DropQueue();
+    const InterruptLock lock;
+    FinishStop();
+    accepted_homed_ = 0;
+    endstop_hit_ = false;
+  }
+
   // In Tick(): an output (or input) failed; Fill() drops the queue.
   // A fault found by the main loop (Tick() records its own).
   void Fault(protocol::ErrorCode error, uint8_t detail) {
@@ -850,6 +908,7 @@ class Device {
   bool pen_lifted_by_pause_ = false;  // the pen is up only because of the pause
   bool lower_pending_ = false;        // kLowering: the pen is yet to be lowered
   bool halt_outputs_ = false;         // HALT: pen up and drivers off on the next tick
+  bool endstop_hit_ = false;          // a hard limit stopped Tick(); Fill() drops the motion
   hal::EndstopInputs* endstops_ = nullptr;
   hal::EndstopState endstops_now_ = {0, 0};
   Homing homing_;

@@ -29,7 +29,7 @@ constexpr int32_t kMaxTravelSteps = (int32_t{1} << 30) - 1;
 /// kMaxPatchSteps + 1 lines.
 constexpr uint16_t kMaxLines = kMaxPatchSteps + 1;
 /// The largest ErrorCode value this version defines.
-constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kHomingFailed);
+constexpr uint8_t kLastErrorCode = static_cast<uint8_t>(ErrorCode::kEndstopHit);
 
 /// Field indices (DecodeResult::field and ErrorReply::detail for kBadField).
 /// For kBadLength the index is that of the field cut short, or the number of

@@ -226,7 +226,15 @@ enum class ErrorCode : uint8_t {
   kUnknownSession = 13,     ///< a resume HELLO for a session the device does not have
   kNotHomed = 14,           ///< motion refused: the configuration requires homing first
   kHomingFailed = 15,       ///< an endstop did not trigger (or release); detail = axis
+  /// A switch triggered while its axis stepped towards it outside HOME (a
+  /// hard limit): the device stopped at once, lifted the pen and forgot
+  /// homing. detail = axis, plus kEndstopHitMax for a max switch; STATUS's
+  /// position is where the axis stopped (its last step made).
+  kEndstopHit = 16,
 };
+
+/// kEndstopHit's detail: this bit set for a max switch, clear for a min one.
+constexpr uint8_t kEndstopHitMax = 4;
 
 /// A short, stable name ("bad length", ...).
 const char* ErrorName(ErrorCode code);

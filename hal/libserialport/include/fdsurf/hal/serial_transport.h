@@ -95,7 +95,9 @@ struct SerialOptions {
 ///
 /// Opening an Arduino's port resets the board through DTR (the kernel raises
 /// DTR on open); its bootloader then ignores the line for 1-2 s, which the
-/// caller rides out by retrying its HELLO.
+/// caller rides out by retrying its HELLO. The port is left with HUPCL
+/// clear, so closing it keeps DTR up and the next open does not reset the
+/// board again (its homing survives from one fdsurf command to the next).
 ///
 /// A hang-up (the master side of a pty closed, a USB-serial adapter
 /// unplugged: POLLHUP, EIO, or end of file) closes the port and gives

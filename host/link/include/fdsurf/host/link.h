@@ -194,6 +194,8 @@ class HostLink {
   bool Acknowledge(uint16_t next_seq, uint8_t credits, uint64_t now_us);
   void HandleError(const protocol::Reply& reply, uint64_t now_us);
   void Fail(std::string message);
+  // The words of a kFault STATUS (an endstop hit names its axis and step).
+  static std::string FaultMessage(const protocol::StatusReport& status);
   void Send(const uint8_t* frame, size_t size, std::vector<uint8_t>* out);
   void SendHello(uint64_t now_us, std::vector<uint8_t>* out);
   void SendStatusQuery(uint64_t now_us, std::vector<uint8_t>* out);

@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Homing a board against its emulator's endstops, end to end (docs/boards.md).
+
+  run_homing_e2e.py --fdsurf build/fdsurf --relay tests/boards/serial_relay.py \\
+      --job examples/bezier-bump.json \\
+      --harness build/boards/mega2560-ramps/host/fdsurf_simavr_board --elf FILE.elf
+
+The harness runs the image with a simulated carriage START_X, START_Y steps
+above its min switches (--endstop-start) and the relay puts its UART on a
+pty LINK. Then, each one a separate `fdsurf` process that opens the link
+anew (the board must keep its state between them: it is not reset):
+
+1. `fdsurf stream JOB --require-homing` on the unhomed board: refused, exit
+   3, a message naming "not homed";
+2. `fdsurf machine home --travel ...`: exit 0;
+3. `fdsurf machine where`: position 0, 0 steps, homed xy;
+4. the harness is stopped and its recording is read: on each axis the
+   STEP pulses went START steps towards the switch (DIR high), then exactly
+   the back-off away from it, and nothing else; the harness's carriage says
+   it ended at the back-off; the board started once (measures: boots 1).
+
+Scenario `hardlimit` instead starts the carriage 40 steps past its X min
+switch (the board counts 0 there, unhomed, as after a carriage pushed by
+hand), then `fdsurf machine goto 10 5` (away from the switch: allowed) and
+`fdsurf machine goto 0 0`: X reaches its switch at counted step 40 and the
+board stops there (kEndstopHit): exit 3 with "X min endstop hit during
+motion at step 40"; the recording shows X 200 steps out and exactly 160
+back, no step past the switch; `fdsurf machine where` then reports X at
+step 40, homed none.
+
+The expected step counts come from this driver's own parameters, not from
+the firmware. Every process runs under a timeout. Exit 0 pass, 1 fail.
+"""
+import argparse
+import os
+import re
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import run_e2e  # noqa: E402  (the processes, the relay's start, the waveform reader)
+from run_e2e import Failure  # noqa: E402
+
+BAUD = 115200
+STEP_MM = 0.05  # 20 steps per mm
+TRAVEL = "40x30"  # 800 x 600 steps: the search budget is 901 x 676 steps
+RATE_MM_S = 10  # 200 steps/s, 1/10 of the board's tick rate
+BACKOFF_MM = 1  # 20 steps
+AXES = ("X", "Y")
+
+
+def machine(args, processes, name, action, extra, timeout_s):
+    """`fdsurf machine ACTION` on the link with the test's machine settings;
+    returns (exit code, its output)."""
+    command = [args.fdsurf, "machine", action, "--device", "serial:%s:%d" % (args.link, BAUD),
+               "--step", str(STEP_MM), "--travel", TRAVEL] + extra
+    code = run_e2e.run_logged(processes, name, command, timeout_s)
+    with open(os.path.join(processes.workdir, name + ".log")) as f:
+        return code, f.read()
+
+
+def refused_unhomed(args, processes):
+    command = [args.fdsurf, "stream", args.job, "--device", "serial:%s:%d" % (args.link, BAUD),
+               "--step", str(STEP_MM), "--travel", TRAVEL, "--fit", "20x15", "--lines", "2",
+               "--require-homing", "-q"]
+    code = run_e2e.run_logged(processes, "unhomed", command, 120)
+    with open(os.path.join(processes.workdir, "unhomed.log")) as f:
+        output = f.read()
+    if code != 3 or "not homed" not in output:
+        raise Failure("a --require-homing job on the unhomed board: exit %d, expected 3 with "
+                      "'not homed' in: %s" % (code, output.strip()[-300:]))
+    print("run_homing_e2e: ok: an unhomed board refuses a --require-homing job (exit 3)")
+
+
+def steps_by_direction(transitions, axis):
+    """The runs of STEP rising edges on `axis`: [(negative, count), ...]."""
+    runs, dir_level, step_level = [], 0, 0
+    for _, name, level in transitions:
+        if name == axis + "_DIR":
+            dir_level = level
+        elif name == axis + "_STEP":
+            if level == 1 and step_level == 0:
+                negative = dir_level == 1
+                if runs and runs[-1][0] == negative:
+                    runs[-1] = (negative, runs[-1][1] + 1)
+                else:
+                    runs.append((negative, 1))
+            step_level = level
+    return runs
+
+
+def check_recording(rec, starts, backoff_steps):
+    header, transitions = run_e2e.read_transitions(rec)
+    if run_e2e.header_value(header, "dir_negative_level") != ["1"]:
+        raise Failure("%s: expected '# dir_negative_level 1'" % rec)
+    for axis, start in zip(AXES, starts):
+        runs = steps_by_direction(transitions, axis)
+        expected = [(True, start), (False, backoff_steps)]
+        if runs != expected:
+            raise Failure("%s's steps were %s (negative?, count), expected %d towards the "
+                          "switch and %d back off: %s" % (axis, runs, start, backoff_steps,
+                                                          expected))
+        print("run_homing_e2e: ok: %s stepped %d towards its switch, stopped on it, backed "
+              "off %d" % (axis, start, backoff_steps))
+
+
+def hard_limit(args, processes, rec):
+    """Scenario hardlimit (the carriage started at --start -40,10)."""
+    code, output = machine(args, processes, "out", "goto", ["10", "5"], 60)
+    if code != 0:
+        raise Failure("goto 10 5 (away from the triggered switch) exited with %d: %s" %
+                      (code, output.strip()[-300:]))
+    code, output = machine(args, processes, "back", "goto", ["0", "0"], 60)
+    expected = ("X min endstop hit during motion at step 40: the position is lost; home the "
+                "machine (fdsurf machine home)")
+    if code != 3 or expected not in output:
+        raise Failure("goto 0 0 into the X switch: exit %d, expected 3 and %r in: %s" %
+                      (code, expected, output.strip()[-400:]))
+    print("run_homing_e2e: ok: the board stopped at the X switch: %s" % output.strip()[-160:])
+    code, output = machine(args, processes, "where", "where", [], 60)
+    if code != 0 or "(steps 40," not in output or "homed none" not in output:
+        raise Failure("fdsurf machine where after the hit said %r (exit %d): expected X at "
+                      "step 40, homed none" % (output.strip(), code))
+    time.sleep(0.3)
+    processes.stop("relay")
+    if processes.stop("harness") != 0:
+        raise Failure("the harness did not exit cleanly after SIGTERM")
+    _, transitions = run_e2e.read_transitions(rec)
+    runs = steps_by_direction(transitions, "X")
+    if runs != [(False, 200), (True, 160)]:
+        raise Failure("X's steps were %s (negative?, count), expected 200 out and 160 back "
+                      "to the switch, none past it" % runs)
+    print("run_homing_e2e: ok: X went 200 steps out and 160 back, none past its switch")
+
+
+def run(args, processes):
+    work = processes.workdir
+    rec = os.path.join(work, "rec.wave")
+    measures = os.path.join(work, "measures.tsv")
+    sock = os.path.join(work, "uart.sock")
+    args.link = os.path.join(work, "ttyBOARD")
+    starts = [int(v) for v in args.start.split(",")]
+    backoff_steps = round(BACKOFF_MM / STEP_MM)
+    processes.start("harness", args.harness + [
+        "--elf", args.elf, "--uart-socket", sock, "--waveform", rec, "--measures", measures,
+        "--time-limit-s", str(args.time_limit_s), "--endstop-start", args.start], 60)
+    processes.start("relay", [sys.executable, args.relay, "--socket", sock, "--link",
+                              args.link], 30)
+    time.sleep(0.2)
+    if args.scenario == "hardlimit":
+        return hard_limit(args, processes, rec)
+    refused_unhomed(args, processes)
+    code, output = machine(args, processes, "home", "home",
+                           ["--rate", str(RATE_MM_S), "--backoff", str(BACKOFF_MM)], 120)
+    if code != 0:
+        raise Failure("fdsurf machine home exited with %d: %s" % (code, output.strip()[-300:]))
+    code, output = machine(args, processes, "where", "where", [], 60)
+    expected = "(steps 0, 0)"  # homing sets the position at the back-off's end to 0
+    if code != 0 or expected not in output or "homed xy" not in output:
+        raise Failure("fdsurf machine where (a new connection) exited with %d and said %r: "
+                      "expected %s and 'homed xy'" % (code, output.strip(), expected))
+    print("run_homing_e2e: ok: a second connection finds the board homed at 0, 0")
+    time.sleep(0.3)
+    processes.stop("relay")
+    if processes.stop("harness") != 0:
+        raise Failure("the harness did not exit cleanly after SIGTERM")
+    check_recording(rec, starts, backoff_steps)
+    with open(os.path.join(work, "harness.log")) as f:
+        carriage = re.findall(r"carriage X (-?\d+) Y (-?\d+)", f.read())
+    if carriage != [(str(backoff_steps), str(backoff_steps))]:
+        raise Failure("the harness's carriage ended at %s, expected X %d Y %d" %
+                      (carriage, backoff_steps, backoff_steps))
+    boots = run_e2e.read_measures(measures).get("boots")
+    if boots != 1:
+        raise Failure("the board started %s times: reset between the connections?" % boots)
+    print("run_homing_e2e: ok: the carriage rests %d steps off each switch; one boot" %
+          backoff_steps)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--fdsurf", required=True)
+    parser.add_argument("--relay", required=True)
+    parser.add_argument("--job", required=True, help="a patch file (refused unhomed)")
+    parser.add_argument("--elf", required=True)
+    parser.add_argument("--scenario", choices=("home", "hardlimit"), default="home")
+    parser.add_argument("--start",
+                        help="steps from each min switch at start, X,Y (default 300,200; "
+                             "hardlimit: -40,10)")
+    parser.add_argument("--time-limit-s", type=int, default=200)
+    parser.add_argument("--workdir", help="keep the files here (default: a temporary folder)")
+    parser.add_argument("--harness", nargs=argparse.REMAINDER, required=True)
+    args = parser.parse_args()
+    if args.start is None:
+        args.start = "-40,10" if args.scenario == "hardlimit" else "300,200"
+    workdir = args.workdir or tempfile.mkdtemp(prefix="fdsurf-homing-e2e-")
+    os.makedirs(workdir, exist_ok=True)
+    processes = run_e2e.Processes(workdir)
+    try:
+        run(args, processes)
+        print("run_homing_e2e: PASS (files in %s)" % workdir)
+        return 0
+    except Failure as failure:
+        processes.stop_all()
+        processes.print_tails()
+        print("run_homing_e2e: FAIL: %s (files in %s)" % (failure, workdir))
+        return 1
+    finally:
+        processes.stop_all()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
