@@ -9,6 +9,11 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
+  # Optional library baselines of the host benchmark (bench/CMakeLists.txt,
+  # docs/performance.md): OpenCASCADE (LGPL-2.1) and SISL (AGPL-3). Linked
+  # into bench/fdsurf_bench only, never into anything fdsurf installs; the
+  # build works without them.
+  libocct-modeling-data-dev libocct-foundation-dev libsisl-dev
   libcli11-dev nlohmann-json3-dev
   # Machine profiles (docs/machines.md).
   libtomlplusplus-dev
