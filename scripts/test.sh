@@ -7,8 +7,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
+# Each section says when it starts (seconds since the start), so a slow CI
+# run shows where its time went.
+section() { echo "== [${SECONDS} s] $*"; }
 
-echo "== build (Release) and test, with every microcontroller image under its emulator"
+section "build (Release) and test, with every microcontroller image under its emulator"
 bash scripts/setup.sh
 # Includes the Target.* tests: each builds a cross target in build/targets/<target>
 # and runs its image under QEMU or simavr against the host reference, and the
@@ -17,7 +20,7 @@ bash scripts/setup.sh
 # download into build/tests/kernel/kernel-cache). Not in the sanitizer build.
 ctest --test-dir build --output-on-failure --parallel "$jobs"
 
-echo "== Debian package of the tool: cpack, install, run, remove"
+section "Debian package of the tool: cpack, install, run, remove"
 # CI runs as root (README). The -dev package is built beside it and tested
 # through the install tests (Package.*).
 (cd build && cpack -G DEB >/dev/null)
@@ -32,20 +35,20 @@ if [ "$installed" != "fdsurf $version" ]; then
 fi
 echo "$deb: /usr/bin/fdsurf --version: $installed"
 
-echo "== build with -fsanitize=address,undefined and test"
+section "build with -fsanitize=address,undefined and test"
 FDSURF_BUILD_DIR=build-sanitize FDSURF_BUILD_TYPE=Debug \
   FDSURF_CMAKE_ARGS="-DFDSURF_SANITIZE=ON -DFDSURF_BUILD_BENCH=OFF" bash scripts/setup.sh
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build-sanitize --output-on-failure --parallel "$jobs"
 
-echo "== fuzz targets under ASan+UBSan: regressions and corpora, then 45 s of fuzzing each"
+section "fuzz targets under ASan+UBSan: regressions and corpora, then 45 s of fuzzing each"
 # fuzz/README.md; a long run by hand: bash scripts/fuzz.sh 3600
 bash scripts/fuzz.sh 45
 
-echo "== clang-format"
+section "clang-format"
 git ls-files '*.cc' '*.h' | xargs clang-format --dry-run -Werror
 
-echo "== clang-tidy (firmware/, hal/, host/, sim/, tools/, the boards' emulator harnesses, the test image's host build)"
+section "clang-tidy (firmware/, hal/, host/, sim/, tools/, the boards' emulator harnesses, the test image's host build)"
 # clang-tidy counts the (filtered-out) warnings of system headers on stderr;
 # show its output only when it fails.
 if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tools/*.cc' 'targets/image/*.cc' 'boards/*/host/*.cc' \
@@ -54,4 +57,4 @@ if ! tidy=$(git ls-files 'firmware/*.cc' 'host/*.cc' 'hal/*.cc' 'sim/*.cc' 'tool
   echo "$tidy" | grep -v 'warnings generated'
   exit 1
 fi
-echo "all checks passed"
+echo "all checks passed in ${SECONDS} s"
