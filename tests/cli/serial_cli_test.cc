@@ -426,6 +426,75 @@ TEST_F(SerialCli, AJobKilledMidwayIsResumedFromItsJournalDrawingNothingTwice) {
   EXPECT_EQ(StopDevice()["hellos"], "0");
 }
 
+// A power cut mid-job (the pty device's SIGUSR2: its session, position and
+// homing gone, the carriage where it stood): the tool, with a journal, says
+// how to go on and exits 3; the user homes the machine and resumes. The
+// points drawn over both runs are exactly those of one uninterrupted run
+// (nothing left out, nothing off the drawing: the homing found the same
+// origin), and what is drawn twice is bounded by what the device executed
+// after the journal's last report (docs/protocol.md, "Power loss").
+TEST_F(SerialCli, APowerCutMidJobIsResumedFromItsJournalAfterHoming) {
+  const fs::path gcode = dir_ / "zigzag.gcode";
+  std::ofstream(gcode) << Zigzag();
+  const std::string device = " --device 'serial:" + link_ + "'";
+  const std::string job = "stream '" + gcode.string() + "' --view top --fit none --speed 40" +
+                          device + " --require-homing";
+  const std::string home = "machine home --rate 40 --backoff 1 --travel 100x80" + device;
+  StartDevice("--speedup 20 --endstops 800,400");
+  ASSERT_EQ(Run(home).exit_code, 0);
+  ASSERT_EQ(Run(job).exit_code, 0);
+  auto clean = StopDevice();
+  ASSERT_NE(clean["drawn_points"], "0");
+
+  StartDevice("--speedup 1 --endstops 800,400 --back-after-ms 300");
+  ASSERT_EQ(Run(home).exit_code, 0);
+  const std::string journal = (dir_ / "job.journal").string();
+  const auto start = Clock::now();
+  const pid_t pid = Spawn(job + " --journal '" + journal + "' --reconnect-timeout 5");
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  kill(device_, SIGUSR2);
+  const Result cut = Finish(pid, start, 30);
+  EXPECT_EQ(cut.exit_code, 3) << cut.err;
+  EXPECT_NE(cut.err.find("device lost the session on resume"), std::string::npos) << cut.err;
+  EXPECT_NE(cut.err.find("fdsurf: the journal " + journal + " records "), std::string::npos)
+      << cut.err;
+  EXPECT_NE(cut.err.find("home it (fdsurf machine home), then run the same command with "
+                         "--resume " +
+                         journal),
+            std::string::npos)
+      << cut.err;
+  const std::string written = Slurp(journal);
+  ASSERT_EQ(written.find("executed 34\n"), std::string::npos) << "the job ended before the cut";
+  const std::size_t at = written.find("executed ");
+  ASSERT_NE(at, std::string::npos) << written;
+  const int journal_executed = std::stoi(written.substr(at + 9));
+
+  // Without homing the fresh device refuses to move (the job requires it).
+  Result r = Run(job + " --resume '" + journal + "'");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("not homed"), std::string::npos) << r.err;
+  ASSERT_EQ(Run(home).exit_code, 0);
+  r = Run(job + " --resume '" + journal + "'", 60);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("resuming " + journal + ": " + std::to_string(journal_executed) +
+                       " of 34 commands executed (as the journal says"),
+            std::string::npos)
+      << r.err;
+  auto report = StopDevice();
+  EXPECT_EQ(report["power_cuts"], "1");
+  EXPECT_EQ(report["drawn_digest"], clean["drawn_digest"]);
+  EXPECT_EQ(report["drawn_points"], clean["drawn_points"]);
+  EXPECT_EQ(report["pen_down"], "0");
+  // Drawn twice: the pen-down steps beyond the clean run's, at most two of
+  // the zigzag's strokes (2 by 10 mm, at most 160 + 800 step events at
+  // 80 steps/mm: the stroke cut short, and one the device finished after
+  // the journal's last write, which comes at most 200 ms after each).
+  const long again = std::stol(report["pen_down_steps"]) - std::stol(clean["pen_down_steps"]);
+  RecordProperty("pen_down_steps_drawn_twice", static_cast<int>(again));  // 635..664 measured
+  EXPECT_GE(again, 0);
+  EXPECT_LE(again, 2 * 960) << "pen-down steps drawn twice";
+}
+
 // `fdsurf machine` against the pty device with min endstops 800 and 400
 // steps (10 and 5 mm) from where the carriage starts: the device keeps its
 // position and homing between invocations, as a powered board does.

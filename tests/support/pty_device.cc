@@ -15,6 +15,13 @@
 //                        sees a hang-up); after --back-after-ms M (500) it
 //                        opens a new pty and points the symlink at it. The
 //                        Device keeps its state and keeps moving meanwhile.
+// SIGUSR2               a power cut: the pty closes, the Device is rebuilt
+//                        from nothing (no session, position 0, not homed,
+//                        an empty queue), the pen goes up and the drivers
+//                        off; the carriage stays where it physically is
+//                        (the switches and the drawn points keep counting
+//                        from where it started). After --back-after-ms M it
+//                        comes back on a new pty, as a board powered again.
 // --speedup K            K device ticks of 1/tick-hz s per real 1/tick-hz s.
 // --endstops X,Y         min endstop switches on X and Y; the carriage starts
 //                        X, Y steps from them (so HOME has to search).
@@ -22,7 +29,9 @@
 // Prints "ready" once the link exists. On SIGTERM, SIGINT or the time limit
 // (30 s) it writes the report (key value lines: executed commands, steps per
 // axis, a digest of every step and pen change in order, stops received,
-// HELLOs, duplicates, pen state, whether it was at rest) and exits 0. On
+// HELLOs, duplicates, pen state, whether it was at rest; the points the pen
+// was down on, counted once and as a digest of the set, and the pen-down
+// steps counted with repeats; the power cuts) and exits 0. On
 // SIGUSR1 it writes the report as it is now and goes on (a snapshot, e.g.
 // while the host pauses between layers). The report is renamed into place,
 // so a reader never sees half of one.
@@ -39,7 +48,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "fdsurf/device/device.h"
 #include "fdsurf/hal/inputs.h"
@@ -49,8 +61,10 @@ namespace {
 
 volatile sig_atomic_t g_quit = 0;
 volatile sig_atomic_t g_snapshot = 0;
+volatile sig_atomic_t g_power_cut = 0;
 void OnSignal(int) { g_quit = 1; }
 void OnSnapshot(int) { g_snapshot = 1; }
+void OnPowerCut(int) { g_power_cut = 1; }
 
 struct Options {
   std::string link;
@@ -81,6 +95,25 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
   uint64_t step_digest = 14695981039346656037ull;
   bool pen_down = false;
   bool enabled = false;
+  /// Where the pen was down: each point once (its position after a step).
+  std::set<std::pair<int64_t, int64_t>> drawn;
+  /// Pen-down steps, repeats included (more than drawn.size() when a
+  /// stretch was drawn twice).
+  uint64_t pen_down_steps = 0;
+
+  /// A digest of `drawn` (in its order, so of the set alone).
+  uint64_t DrawnDigest() const {
+    uint64_t h = 14695981039346656037ull;
+    for (const auto& [x, y] : drawn) {
+      for (const int64_t v : {x, y}) {
+        for (int b = 0; b < 8; ++b) {
+          h ^= static_cast<uint8_t>(static_cast<uint64_t>(v) >> (8 * b));
+          h *= 1099511628211ull;
+        }
+      }
+    }
+    return h;
+  }
 
  private:
   void Fold(uint8_t byte) {
@@ -99,6 +132,10 @@ class RecordingOutputs final : public fdsurf::hal::StepDirOutputs, public fdsurf
     for (int a = 0; a < 3; ++a) {
       steps[a] += (axis_mask >> a) & 1u;
       if ((axis_mask >> a & 1u) != 0) position[a] += (negative_ >> a & 1u) != 0 ? -1 : 1;
+    }
+    if (pen_down) {
+      drawn.insert({position[0], position[1]});
+      ++pen_down_steps;
     }
     const auto byte = static_cast<uint8_t>(axis_mask | (negative_ & axis_mask) << 4);
     Fold(byte);
@@ -219,7 +256,7 @@ long MsSince(Clock::time_point t) {
 
 struct Run {
   const Options& o;
-  fdsurf::device::Device<2> device;
+  std::optional<fdsurf::device::Device<2>> device;  // rebuilt by a power cut
   RecordingOutputs outputs;
   MinSwitches switches{outputs, o.endstop_offset};
   Pty pty;
@@ -229,9 +266,25 @@ struct Run {
   bool down = false;  // hung up, waiting to come back
   Clock::time_point down_since;
   uint64_t ticks_done = 0;
+  unsigned power_cuts = 0;
 
-  explicit Run(const Options& options) : o(options), device(options.tick_hz) {
-    if (options.endstops) device.set_endstops(&switches);
+  explicit Run(const Options& options) : o(options) { PowerOn(); }
+
+  void PowerOn() {
+    device.emplace(o.tick_hz);
+    if (o.endstops) device->set_endstops(&switches);
+  }
+
+  // SIGUSR2: the device loses power (see the top of the file).
+  void PowerCut() {
+    pty.Close();
+    unlink(o.link.c_str());
+    down = true;
+    down_since = Clock::now();
+    outputs.pen_down = false;
+    outputs.enabled = false;
+    ++power_cuts;
+    PowerOn();
   }
 
   // Bytes in from the host, replies out.
@@ -245,7 +298,7 @@ struct Run {
       }
       ++bytes_in;
       const bool silent = o.never_answer || MsSince(first_byte) < o.silent_ms;
-      if (!silent) device.OnByte(buffer[i]);
+      if (!silent) device->OnByte(buffer[i]);
       if (o.hangup_after_bytes >= 0 && bytes_in == o.hangup_after_bytes && !down) {
         pty.Close();
         unlink(o.link.c_str());
@@ -254,7 +307,7 @@ struct Run {
         break;
       }
     }
-    for (size_t got; (got = device.ReadOutput(buffer, sizeof buffer)) > 0;) {
+    for (size_t got; (got = device->ReadOutput(buffer, sizeof buffer)) > 0;) {
       if (pty.master >= 0) (void)!write(pty.master, buffer, got);
     }
     if (down && MsSince(down_since) >= o.back_after_ms) {
@@ -268,7 +321,7 @@ struct Run {
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const auto due = static_cast<uint64_t>(elapsed * o.tick_hz * o.speedup);
     for (int budget = 4096; ticks_done < due && budget > 0; --budget, ++ticks_done) {
-      (void)device.Tick(outputs, outputs);
+      (void)device->Tick(outputs, outputs);
     }
     ticks_done = std::max(ticks_done, due > 100000 ? due - 100000 : 0);
   }
@@ -278,21 +331,24 @@ struct Run {
     const std::string temporary = o.report + ".new";
     FILE* f = std::fopen(temporary.c_str(), "w");
     if (f == nullptr) return;
-    const auto& stats = device.link_stats();
-    std::fprintf(f, "executed %u\nsteps_x %llu\nsteps_y %llu\ndigest %016llx\n", device.executed(),
+    const auto& stats = device->link_stats();
+    std::fprintf(f, "executed %u\nsteps_x %llu\nsteps_y %llu\ndigest %016llx\n", device->executed(),
                  static_cast<unsigned long long>(outputs.steps[0]),
                  static_cast<unsigned long long>(outputs.steps[1]),
                  static_cast<unsigned long long>(outputs.digest));
     std::fprintf(f, "stops %u\nhellos %u\nduplicates %u\naccepted %u\npen_down %d\nidle %d\n",
                  stats.stops, stats.hellos, stats.duplicates, stats.commands_accepted,
-                 outputs.pen_down ? 1 : 0, device.Idle() ? 1 : 0);
+                 outputs.pen_down ? 1 : 0, device->Idle() ? 1 : 0);
     std::fprintf(f, "bytes_in %ld\n", bytes_in);
     fdsurf::protocol::StatusReport status{};
-    device.FillStatus(&status);
+    device->FillStatus(&status);
     std::fprintf(f, "pauses %u\nresumes %u\nhalts %u\nstep_digest %016llx\nenabled %d\nstate %d\n",
                  stats.pauses, stats.resumes, stats.halts,
                  static_cast<unsigned long long>(outputs.step_digest), outputs.enabled ? 1 : 0,
                  static_cast<int>(status.state));
+    std::fprintf(f, "drawn_points %zu\ndrawn_digest %016llx\npen_down_steps %llu\npower_cuts %u\n",
+                 outputs.drawn.size(), static_cast<unsigned long long>(outputs.DrawnDigest()),
+                 static_cast<unsigned long long>(outputs.pen_down_steps), power_cuts);
     std::fclose(f);
     std::rename(temporary.c_str(), o.report.c_str());
   }
@@ -310,6 +366,9 @@ int main(int argc, char** argv) {
   struct sigaction snapshot {};
   snapshot.sa_handler = OnSnapshot;
   sigaction(SIGUSR1, &snapshot, nullptr);
+  struct sigaction power_cut {};
+  power_cut.sa_handler = OnPowerCut;
+  sigaction(SIGUSR2, &power_cut, nullptr);
   signal(SIGPIPE, SIG_IGN);
   auto run = std::make_unique<Run>(o);
   if (!run->pty.Open(o.link)) return 1;
@@ -321,8 +380,12 @@ int main(int argc, char** argv) {
     pollfd p{run->pty.master, POLLIN, 0};
     (void)poll(&p, run->pty.master >= 0 ? 1 : 0, 1);
     run->Service();
-    run->device.Fill();
+    run->device->Fill();
     run->Tick(start);
+    if (g_power_cut != 0) {
+      g_power_cut = 0;
+      run->PowerCut();
+    }
     if (g_snapshot != 0) {
       g_snapshot = 0;
       run->Report();

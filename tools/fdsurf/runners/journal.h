@@ -79,6 +79,8 @@ class JobJournal {
   /// Writes what it has now.
   void Flush();
   FDSURF_NODISCARD const JournalState& state() const { return state_; }
+  /// The file it writes.
+  FDSURF_NODISCARD const std::string& path() const { return path_; }
 
  private:
   using Clock = std::chrono::steady_clock;

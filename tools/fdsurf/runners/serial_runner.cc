@@ -127,7 +127,7 @@ int RunSerial(const StreamOptions& o, const StreamJob& job) {
   const StreamJob to_run = JobWithJournal(o, job, fitted, old_executed, &loop, &journal);
   ProgressLine progress(ShowProgress(o.quiet));
   progress.SetSchedule(o.resume_state ? nullptr : o.schedule.get());
-  const int code = loop.Run(to_run, &progress);
+  const int code = RunKeepingJournal(&loop, to_run, &progress, &journal);
   if (code != 0 || o.quiet) return code;
   const HostLinkStats& stats = loop.link().stats();
   std::fprintf(stderr,

@@ -286,6 +286,23 @@ StreamJob JobWithJournal(const StreamOptions& o, const StreamJob& job, const Str
   return rest;
 }
 
+int RunKeepingJournal(TransportLoop* loop, const StreamJob& job, ProgressLine* progress,
+                      std::optional<JobJournal>* journal) {
+  try {
+    return loop->Run(job, progress);
+  } catch (const DeviceError& e) {
+    if (!journal->has_value()) throw;
+    JobJournal& kept = **journal;
+    kept.Flush();
+    const JournalState& state = kept.state();
+    throw DeviceError(std::string(e.what()) + "\nfdsurf: the journal " + kept.path() + " records " +
+                      std::to_string(state.executed) + " of " + std::to_string(state.commands) +
+                      " job commands executed; if the device was reset or lost power, home it "
+                      "(fdsurf machine home), then run the same command with --resume " +
+                      kept.path());
+  }
+}
+
 int TransportLoop::HaltAndReport() {
   if (!options_.quiet) std::fprintf(stderr, "\nfdsurf: interrupted again: halting the device\n");
   link_.RequestHalt();

@@ -123,6 +123,14 @@ StreamJob JobWithJournal(const StreamOptions& o, const StreamJob& job, const Str
                          std::optional<std::uint32_t> old_executed, TransportLoop* loop,
                          std::optional<JobJournal>* journal);
 
+/// `loop->Run(job, progress)`. When the device is lost mid-job (a
+/// DeviceError: unplugged and not back, reset or powered off, so that it no
+/// longer has the session) and a journal is kept, writes the journal once
+/// more and adds to the error what it records and how to go on: home the
+/// machine if it lost its position, then the same command with --resume.
+int RunKeepingJournal(TransportLoop* loop, const StreamJob& job, ProgressLine* progress,
+                      std::optional<JobJournal>* journal);
+
 /// Seconds (an option) as whole milliseconds, rounded up.
 std::uint32_t Milliseconds(double seconds);
 

@@ -38,7 +38,7 @@ int RunUsb(const StreamOptions& o, const StreamJob& job) {
   const StreamJob to_run = JobWithJournal(o, job, fitted, old_executed, &loop, &journal);
   ProgressLine progress(ShowProgress(o.quiet));
   progress.SetSchedule(o.resume_state ? nullptr : o.schedule.get());
-  const int code = loop.Run(to_run, &progress);
+  const int code = RunKeepingJournal(&loop, to_run, &progress, &journal);
   if (code != 0 || o.quiet) return code;
   std::fprintf(stderr, "%s: %s drawn by usb %s; %llu frames sent (%llu resent)\n", o.file.c_str(),
                JobContents(job).c_str(), selector.ToString().c_str(),
