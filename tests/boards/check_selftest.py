@@ -9,6 +9,7 @@ recording cut at a rest with --prefix.
   check_selftest.py FDSURF CHECKER JOB
 """
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -139,7 +140,11 @@ def main():
     print("%s: a file that is not a waveform (exit %d)" % ("ok  " if ok else "FAIL",
                                                           result.returncode))
     failed += 0 if ok else 1
-    return 1 if failed else 0
+    if failed:
+        print("files in %s" % work)
+        return 1
+    shutil.rmtree(work, ignore_errors=True)
+    return 0
 
 
 if __name__ == "__main__":

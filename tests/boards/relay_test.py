@@ -9,6 +9,7 @@ unplug) and re-points the link at a new pty that works.
   relay_test.py [RELAY]   (default: serial_relay.py beside this file)
 """
 import os
+import shutil
 import select
 import socket
 import subprocess
@@ -126,7 +127,11 @@ def test_hangup(work):
 
 def main():
     work = tempfile.mkdtemp(prefix="fdsurf-relay-test-")
-    return 1 if test_corrupt(work) + test_hangup(work) else 0
+    if test_corrupt(work) + test_hangup(work):
+        print("files in %s" % work)
+        return 1
+    shutil.rmtree(work, ignore_errors=True)
+    return 0
 
 
 if __name__ == "__main__":

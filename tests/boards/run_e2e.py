@@ -37,6 +37,7 @@ import os
 import re
 import select
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -536,7 +537,11 @@ def main():
     processes = Processes(workdir)
     try:
         run(args, processes)
-        print("run_e2e: %s %s: PASS (files in %s)" % (args.board, args.scenario, workdir))
+        processes.stop_all()
+        print("run_e2e: %s %s: PASS" % (args.board, args.scenario))
+        # A temporary folder goes when the run passed; one that failed stays for its files.
+        if not args.workdir:
+            shutil.rmtree(workdir, ignore_errors=True)
         return 0
     except Failure as failure:
         processes.stop_all()

@@ -35,6 +35,7 @@ the firmware. Every process runs under a timeout. Exit 0 pass, 1 fail.
 import argparse
 import os
 import re
+import shutil
 import sys
 import tempfile
 import time
@@ -201,7 +202,11 @@ def main():
     processes = run_e2e.Processes(workdir)
     try:
         run(args, processes)
-        print("run_homing_e2e: PASS (files in %s)" % workdir)
+        processes.stop_all()
+        print("run_homing_e2e: PASS")
+        # A temporary folder goes when the run passed; one that failed stays for its files.
+        if not args.workdir:
+            shutil.rmtree(workdir, ignore_errors=True)
         return 0
     except Failure as failure:
         processes.stop_all()
