@@ -17,6 +17,10 @@ rebind  the teapot, with the gadget unbound from and bound again to the UDC
         the same drawing, every command executed once.
 silent  a gadget that reads and never answers: fdsurf exits 3 with an error
         naming the device, within its --connect-timeout, no hang.
+machine `fdsurf machine` commands one after the other on the same gadget
+        (where, pen down, pen up, goto, jog, where, motors off): each answers
+        with the position the gadget's Device reports, the gadget keeps it
+        between invocations, and its steps are those of the moves asked.
 Exits 0 when every check holds; else prints what differed and the guest's
 console tail and exits 1.
 """
@@ -158,6 +162,15 @@ wait $HOST
 echo "FDSURF-RESULT teapot.exit $?"
 echo "FDSURF-RESULT teapot.stderr $(tr '\\r' '\\n' < /tmp/stderr | grep -v '^fdsurf: \\[' | tr '\\n' '|')"
 {stop_gadget("teapot.")}""")
+    elif case == "machine":
+        body.append("start_gadget")
+        for index, command in enumerate(MACHINE_COMMANDS):
+            body.append(
+                f"fdsurf machine {command} --device $DEVICE --travel 100x80 > /tmp/out 2> /tmp/stderr\n"
+                f'echo "FDSURF-RESULT machine{index}.exit $?"\n'
+                f"echo \"FDSURF-RESULT machine{index}.out $(tr '\\n' '|' < /tmp/out)\"\n"
+                f"echo \"FDSURF-RESULT machine{index}.stderr $(tr '\\n' '|' < /tmp/stderr)\"")
+        body.append(stop_gadget("machine."))
     else:
         body.append(f"""
 start_gadget --never-answer
@@ -166,6 +179,20 @@ echo "FDSURF-RESULT bump.exit $?"
 echo "FDSURF-RESULT bump.stderr $(tr '\\n' '|' < /tmp/stderr)"
 {stop_gadget("bump.")}""")
     return "\n".join(body)
+
+
+# The machine case's commands and what each must print (a part of its
+# output; 80 steps per mm, the tool's default step of 0.0125 mm).
+MACHINE_COMMANDS = ["where", "pen down", "pen up", "goto 10 5", "jog 2 -1", "where", "motors off"]
+MACHINE_OUTPUTS = [
+    "position x 0, y 0 mm (steps 0, 0); pen up; motors off",
+    "(steps 0, 0); pen down; motors off",
+    "(steps 0, 0); pen up; motors off",
+    "position x 10, y 5 mm (steps 800, 400); pen up; motors on",
+    "position x 12, y 4 mm (steps 960, 320); pen up; motors on",
+    "position x 12, y 4 mm (steps 960, 320); pen up; motors on",
+    "(steps 960, 320); pen up; motors off",
+]
 
 
 def reference(fdsurf, examples, job, workdir):
@@ -241,6 +268,19 @@ def check(klass, case, results, references):
         if got != wanted:
             problems.append(f"{key}: {got!r}, expected {wanted!r}")
 
+    if case == "machine":
+        for index, wanted in enumerate(MACHINE_OUTPUTS):
+            expect(f"machine{index}.exit", "0")
+            out = results.get(f"machine{index}.out", "")
+            if wanted not in out:
+                problems.append(f"machine {MACHINE_COMMANDS[index]}: {out!r} lacks {wanted!r} "
+                                f"(stderr {results.get(f'machine{index}.stderr', '')!r})")
+        # The moves' steps: 800 + 160 in X, 400 + 80 in Y, and where they end.
+        expect("machine.steps_x", "960")
+        expect("machine.steps_y", "480")
+        expect("machine.position", "960,320")
+        expect("machine.pen_down", "0")
+        return problems
     jobs = list(JOBS) if case == "stream" else ["teapot"] if case == "rebind" else ["bump"]
     for job in jobs:
         if case == "silent":
@@ -280,7 +320,8 @@ def check(klass, case, results, references):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--class", dest="klass", choices=["acm", "ffs"], required=True)
-    parser.add_argument("--case", choices=["stream", "rebind", "silent"], required=True)
+    parser.add_argument("--case", choices=["stream", "rebind", "silent", "machine"],
+                        required=True)
     parser.add_argument("--fdsurf", required=True)
     parser.add_argument("--kernel", required=True)
     parser.add_argument("--initrd", required=True)

@@ -17,6 +17,7 @@
 #include "../cli_options.h"
 #include "../runners/runner.h"
 #include "../runners/serial_session.h"
+#include "../runners/usb_session.h"
 #include "../stream_command.h"
 #include "fdsurf/hal/serial_transport.h"
 #include "fdsurf/host/errors.h"
@@ -139,6 +140,27 @@ class SerialConnection final : public Connection {
   SerialSession session_;
 };
 
+// A USB device (usb, usb:VID:PID, usb:BUS-PORT): the same transport loop as
+// `stream --device usb` (usb_session.h). The device keeps its position,
+// homing and motors between invocations, as a serial one does.
+class UsbConnection final : public Connection {
+ public:
+  explicit UsbConnection(const StreamOptions& o) : session_(OpenUsbSession(o)) {
+    if (!session_.loop->Connect()) throw DeviceError(session_.name + ": interrupted");
+  }
+  protocol::HelloReply Hello() override { return *session_.loop->link().hello(); }
+  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
+    ProgressLine progress(false);
+    if (session_.loop->Run(JobOf(commands), &progress) != 0) {
+      throw DeviceError("interrupted; the device was stopped");
+    }
+    return *session_.loop->link().status();
+  }
+
+ private:
+  UsbSession session_;
+};
+
 // The simulated plotter: its carriage starts a third of X's travel and a
 // quarter of Y's (and of Z's) from the min switches.
 class SimConnection final : public Connection {
@@ -196,8 +218,12 @@ std::unique_ptr<Connection> Connect(const Settings& s) {
   const std::string& device = s.stream.device;
   if (device == "sim") return std::make_unique<SimConnection>(s.stream, s);
   if (device.rfind("serial:", 0) == 0) return std::make_unique<SerialConnection>(s.stream);
+  if (device == "usb" || device.rfind("usb:", 0) == 0) {
+    return std::make_unique<UsbConnection>(s.stream);
+  }
   throw InputError("--device " + device +
-                   ": machine commands run on sim and serial:PATH devices so far");
+                   ": machine commands run on sim, usb[:VID:PID|:BUS-PORT] and serial:PATH "
+                   "devices so far");
 }
 
 std::string Where(const Settings& s, const protocol::StatusReport& r) {
