@@ -221,9 +221,15 @@ std::unique_ptr<Connection> Connect(const Settings& s) {
   if (device == "usb" || device.rfind("usb:", 0) == 0) {
     return std::make_unique<UsbConnection>(s.stream);
   }
+  if (device.rfind("gpio:", 0) == 0) {
+    throw InputError("--device " + device +
+                     ": machine commands do not run on gpio devices yet: the tool is the "
+                     "controller there, and nothing holds the position once it exits "
+                     "(docs/machines.md)");
+  }
   throw InputError("--device " + device +
                    ": machine commands run on sim, usb[:VID:PID|:BUS-PORT] and serial:PATH "
-                   "devices so far");
+                   "devices");
 }
 
 std::string Where(const Settings& s, const protocol::StatusReport& r) {
