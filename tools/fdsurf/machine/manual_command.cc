@@ -114,7 +114,24 @@ StreamJob JobOf(const std::vector<protocol::Command>& commands) {
   return job;
 }
 
-class SerialConnection final : public Connection {
+// A device behind a transport loop (serial or usb): HELLO was answered when
+// the connection was made; each job runs to rest through the loop.
+class LoopConnection : public Connection {
+ public:
+  protocol::HelloReply Hello() override { return *loop().link().hello(); }
+  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
+    ProgressLine progress(false);
+    if (loop().Run(JobOf(commands), &progress) != 0) {
+      throw DeviceError("interrupted; the device was stopped");
+    }
+    return *loop().link().status();
+  }
+
+ protected:
+  virtual TransportLoop& loop() = 0;
+};
+
+class SerialConnection final : public LoopConnection {
  public:
   explicit SerialConnection(const StreamOptions& o) {
     hal::SerialSpec spec;
@@ -127,37 +144,23 @@ class SerialConnection final : public Connection {
     if (!session) throw DeviceError(error);
     session_ = std::move(*session);
   }
-  protocol::HelloReply Hello() override { return *session_.loop->link().hello(); }
-  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
-    ProgressLine progress(false);
-    if (session_.loop->Run(JobOf(commands), &progress) != 0) {
-      throw DeviceError("interrupted; the device was stopped");
-    }
-    return *session_.loop->link().status();
-  }
 
  private:
+  TransportLoop& loop() override { return *session_.loop; }
   SerialSession session_;
 };
 
 // A USB device (usb, usb:VID:PID, usb:BUS-PORT): the same transport loop as
 // `stream --device usb` (usb_session.h). The device keeps its position,
 // homing and motors between invocations, as a serial one does.
-class UsbConnection final : public Connection {
+class UsbConnection final : public LoopConnection {
  public:
   explicit UsbConnection(const StreamOptions& o) : session_(OpenUsbSession(o)) {
     if (!session_.loop->Connect()) throw DeviceError(session_.name + ": interrupted");
   }
-  protocol::HelloReply Hello() override { return *session_.loop->link().hello(); }
-  protocol::StatusReport Run(const std::vector<protocol::Command>& commands) override {
-    ProgressLine progress(false);
-    if (session_.loop->Run(JobOf(commands), &progress) != 0) {
-      throw DeviceError("interrupted; the device was stopped");
-    }
-    return *session_.loop->link().status();
-  }
 
  private:
+  TransportLoop& loop() override { return *session_.loop; }
   UsbSession session_;
 };
 
