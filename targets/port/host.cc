@@ -54,7 +54,8 @@ std::string Text(const PreparedPatch<kDims>& p) {
   // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) on "{" + string.
   std::string s = "{";
   s += FormatText(p.format) + ", " + std::to_string(p.steps_s) + ", " + std::to_string(p.steps_t) +
-       ", " + (p.exact ? "true" : "false") + ", {";
+       ", " + (p.exact ? "true" : "false") + ", " + std::to_string(p.s_line_frac_bits) + ", " +
+       std::to_string(p.t_line_frac_bits) + ", {";
   for (int c = 0; c < kDims; ++c) {
     s += "{";
     for (int k = 0; k < 4; ++k) {

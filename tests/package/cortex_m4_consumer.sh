@@ -32,7 +32,10 @@ for add in firmware root; do
   readelf -h "$elf" | grep -q 'Machine:.*ARM' || { echo "$elf: not an ARM ELF" >&2; exit 1; }
   readelf -A "$elf" | grep -q 'Tag_ABI_VFP_args: VFP registers' ||
     { echo "$elf: not hard-float" >&2; exit 1; }
-  arm-none-eabi-nm -C "$elf" | grep -q 'PrepareCurve<2>' ||
+  # Captured first: with pipefail, `nm | grep -q` fails when grep stops
+  # reading early and nm, still writing, dies of SIGPIPE.
+  symbols=$(arm-none-eabi-nm -C "$elf")
+  grep -q 'PrepareCurve<2>' <<<"$symbols" ||
     { echo "$elf: the core's PrepareCurve is not linked" >&2; exit 1; }
   echo "add_subdirectory($add): $(arm-none-eabi-size "$elf" | tail -1 | awk '{print "text " $1 ", data " $2 ", bss " $3}')"
 done

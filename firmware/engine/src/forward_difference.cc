@@ -240,6 +240,39 @@ bool FitsWidth(const Plane& plane, const Axis& s, const Axis& t, const Denominat
   return true;
 }
 
+// A line of the per-line stepper (docs/precision.md, "Per-line rounding")
+// holds the row-0 entries (s-lines) or the column-0 entries (t-lines) in
+// int64_t with `frac_bits` fractional bits: each of those bounds, plus a
+// quantum, must stay below 2^(63-F).
+bool FitsLine(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d, bool s_lines,
+              int frac_bits) {
+  const int headroom = 63 - frac_bits;
+  if (headroom < 1) return false;
+  const Wide limit = d.value.ShiftedLeft(headroom);
+  const int entries = s_lines ? t.size : s.size;
+  for (int e = 0; e < entries; ++e) {
+    const Wide& bound = s_lines ? plane.bound[0][e] : plane.bound[e][0];
+    if (!(bound + d.value < limit)) return false;
+  }
+  return true;
+}
+
+// The line format of one family (0: none): planned for a table in the
+// 128-bit format whose lines have `line_steps` steps, if every coordinate's
+// line fits 64 bits with fewer fractional bits than the table's.
+template <int kDims>
+uint8_t LineFracBits(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
+                     const Denominator& d, bool s_lines, int table_frac_bits,
+                     const PrepareOptions& options) {
+  int frac_bits = RequiredLineFracBits(s_lines ? t.steps : s.steps);
+  frac_bits -= options.test_only_line_frac_bits_removed;
+  if (frac_bits < 1 || frac_bits >= table_frac_bits) return 0;
+  for (int c = 0; c < kDims; ++c) {
+    if (!FitsLine(planes[c], s, t, d, s_lines, frac_bits)) return 0;
+  }
+  return static_cast<uint8_t>(frac_bits);
+}
+
 // Positions themselves (plus a quantum) must fit the int32_t output.
 bool FitsOutput(const Plane& plane, const Denominator& d) {
   return plane.bound[0][0] + d.value < d.value.ShiftedLeft(31);
@@ -248,7 +281,7 @@ bool FitsOutput(const Plane& plane, const Denominator& d) {
 template <int kDims>
 Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, const Axis& t,
                const PrepareOptions& options, DiffFormat* format, bool* exact,
-               Int128 (&table)[kDims][4][4]) {
+               Int128 (&table)[kDims][4][4], uint8_t (*line_frac_bits)[2] = nullptr) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
   if (GetBasisMatrix(basis) == nullptr) return Status::kInvalidArgument;
   const Denominator denominator = MakeDenominator(s, t);
@@ -298,6 +331,13 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   format->acc_bits = static_cast<uint8_t>(acc_bits);
   format->frac_bits = static_cast<uint8_t>(frac_bits);
   *exact = all_exact;
+  if (line_frac_bits != nullptr) {
+    const bool wide = acc_bits == 128 && t.size == 4;
+    for (int family = 0; family < 2; ++family) {
+      (*line_frac_bits)[family] =
+          wide ? LineFracBits(planes, s, t, denominator, family == 0, frac_bits, options) : 0;
+    }
+  }
   return Status::kOk;
 }
 
@@ -305,6 +345,10 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
 
 int RequiredFracBits(uint32_t steps_s, uint32_t steps_t) {
   return BitLength(PropagationCount(steps_s) * PropagationCount(steps_t)) + kGuardBits;
+}
+
+int RequiredLineFracBits(uint32_t steps) {
+  return BitLength(PropagationCount(steps)) + kLineGuardBits;
 }
 
 template <int kDims>
@@ -352,8 +396,12 @@ Status PreparePatch(const PatchGeometry1 (&geometry)[kDims], Basis basis, uint16
     }
   }
   PreparedPatch<kDims> result;
-  const Status status = Prepare(g, basis, s, t, options, &result.format, &result.exact, result.dd);
+  uint8_t line_frac_bits[2];
+  const Status status =
+      Prepare(g, basis, s, t, options, &result.format, &result.exact, result.dd, &line_frac_bits);
   if (status != Status::kOk) return status;
+  result.s_line_frac_bits = line_frac_bits[0];
+  result.t_line_frac_bits = line_frac_bits[1];
   result.steps_s = steps_s;
   result.steps_t = steps_t;
   *out = result;

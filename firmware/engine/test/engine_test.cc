@@ -92,8 +92,36 @@ void Step(const PreparedPatch<3>& prepared, GridPoints* s_lines, GridPoints* t_l
   EXPECT_EQ(count, 2 * static_cast<std::size_t>(s_lines->n + 1) * (s_lines->m + 1));
 }
 
-// Steps the patch both ways and checks every point against the exact value.
-// Returns the number of points that broke the bound.
+// One stepping of the whole grid, to be checked point by point.
+struct SteppedGrid {
+  const char* how;
+  GridPoints points;
+};
+
+// The per-line stepper (LinePatchStepper), both families, where the plan has
+// their formats. The two families round different lines, so they need not
+// agree bit for bit: each is checked against the exact patch on its own.
+void StepLines(const PreparedPatch<3>& prepared, std::vector<SteppedGrid>* grids) {
+  const int n = prepared.steps_s;
+  const int m = prepared.steps_t;
+  const std::size_t points = static_cast<std::size_t>(n + 1) * (m + 1);
+  if (prepared.s_line_frac_bits != 0) {
+    grids->push_back({"per-line s-lines", {n, m, std::vector<std::int32_t>(3 * points)}});
+    GridPoints& grid = grids->back().points;
+    LinePatchStepper<3>(prepared).ForEachSLinePoint(
+        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) { grid.Put(i, j, p); });
+  }
+  if (prepared.t_line_frac_bits != 0) {
+    grids->push_back({"per-line t-lines", {n, m, std::vector<std::int32_t>(3 * points)}});
+    GridPoints& grid = grids->back().points;
+    LinePatchStepper<3>(prepared).ForEachTLinePoint(
+        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) { grid.Put(i, j, p); });
+  }
+}
+
+// Steps the patch both ways (and per line, where planned) and checks every
+// point against the exact value, computed once per point. Returns the number
+// of points that broke the bound.
 int CheckPatch(const RawPatch& raw, Basis basis, int n, int m, PrepareOptions options = {},
                bool expect_rounded = false) {
   PreparedPatch<3> prepared;
@@ -101,30 +129,36 @@ int CheckPatch(const RawPatch& raw, Basis basis, int n, int m, PrepareOptions op
   EXPECT_EQ(status, Status::kOk) << StatusMessage(status);
   if (status != Status::kOk) return 1;
   const std::size_t points = static_cast<std::size_t>(n + 1) * (m + 1);
-  GridPoints s_lines{n, m, std::vector<std::int32_t>(3 * points)};
+  std::vector<SteppedGrid> grids;
+  grids.push_back({"table", {n, m, std::vector<std::int32_t>(3 * points)}});
   GridPoints t_lines{n, m, std::vector<std::int32_t>(3 * points)};
   if (prepared.format.acc_bits == 64) {
-    Step<std::int64_t>(prepared, &s_lines, &t_lines);
+    Step<std::int64_t>(prepared, &grids[0].points, &t_lines);
   } else {
-    Step<Int128>(prepared, &s_lines, &t_lines);
+    Step<Int128>(prepared, &grids[0].points, &t_lines);
   }
   // Both families visit the same sum of the same integers at (i, j).
-  EXPECT_EQ(s_lines.xyz, t_lines.xyz) << "s-lines and t-lines disagree";
+  EXPECT_EQ(grids[0].points.xyz, t_lines.xyz) << "s-lines and t-lines disagree";
+  StepLines(prepared, &grids);
+  const bool report =
+      options.test_only_frac_bits_removed == 0 && options.test_only_line_frac_bits_removed == 0;
   int violations = 0;
   for (int i = 0; i <= n; ++i) {
     for (int j = 0; j <= m; ++j) {
       for (int c = 0; c < 3; ++c) {
-        const std::int32_t k = s_lines.xyz[3 * (static_cast<std::size_t>(i) * (m + 1) + j) + c];
+        const std::size_t at = 3 * (static_cast<std::size_t>(i) * (m + 1) + j) + c;
         const Rational exact = ExactPoint(basis, raw.g[c], i, n, j, m);
-        if (!WithinBound(k, exact)) {
-          if (++violations <= 3 && options.test_only_frac_bits_removed == 0) {
-            ADD_FAILURE() << BasisName(basis) << " " << n << "x" << m << " point (" << i << "," << j
-                          << ") coordinate " << c << ": got " << k << ", exact "
-                          << testing::ToDouble(exact);
+        for (const SteppedGrid& grid : grids) {
+          const std::int32_t k = grid.points.xyz[at];
+          if (!WithinBound(k, exact) && ++violations <= 3 && report) {
+            ADD_FAILURE() << BasisName(basis) << " " << n << "x" << m << " " << grid.how
+                          << " point (" << i << "," << j << ") coordinate " << c << ": got " << k
+                          << ", exact " << testing::ToDouble(exact);
           }
         }
         if (expect_rounded) {
-          EXPECT_TRUE(IsRoundedValue(k, exact)) << "(" << i << "," << j << ") " << c;
+          EXPECT_TRUE(IsRoundedValue(grids[0].points.xyz[at], exact))
+              << "(" << i << "," << j << ") " << c;
         }
       }
     }
@@ -234,6 +268,39 @@ TEST(PatchEngine, TheBoundFailsWithoutThePlannedFractionalBits) {
   EXPECT_GT(CheckPatch(patch, Basis::kBSpline, 1024, 1024, weakened), 0);
 }
 
+// Per-line rounding (docs/precision.md): every grid whose table needs the
+// 128-bit accumulator gets 64-bit lines for geometry within ±2^19 quanta,
+// with the line formats of the derivation, and every point of both
+// families is within the bound (CheckPatch steps them; the tests at ±2^20
+// above step them too wherever the planner could give the lines 64 bits).
+TEST(PatchEngine, PerLineRoundingSteps128BitTablesIn64BitLines) {
+  std::mt19937_64 rng(17);
+  const int grids[][2] = {{1024, 1024}, {997, 1024}, {256, 256}, {1024, 40}};
+  for (Basis basis : kAllBases) {
+    for (const auto& grid : grids) {
+      const RawPatch patch = RandomPatch(rng, basis, 1 << 19);
+      PreparedPatch<3> prepared;
+      ASSERT_EQ(Prepare(patch, basis, grid[0], grid[1], &prepared), Status::kOk);
+      ASSERT_EQ(prepared.format.acc_bits, 128) << grid[0] << "x" << grid[1];
+      EXPECT_EQ(prepared.s_line_frac_bits, RequiredLineFracBits(grid[1]))
+          << BasisName(basis) << " " << grid[0] << "x" << grid[1];
+      EXPECT_EQ(prepared.t_line_frac_bits, RequiredLineFracBits(grid[0]))
+          << BasisName(basis) << " " << grid[0] << "x" << grid[1];
+      EXPECT_EQ(CheckPatch(patch, basis, grid[0], grid[1]), 0);
+    }
+  }
+}
+
+// The check above would catch a planner that gave the lines too few bits:
+// with 12 fewer, a 1024×1024 B-spline patch breaks the bound on its lines.
+TEST(PatchEngine, PerLineRoundingFailsWithoutItsPlannedBits) {
+  std::mt19937_64 rng(19);
+  const RawPatch patch = RandomPatch(rng, Basis::kBSpline, 1 << 20);
+  PrepareOptions weakened;
+  weakened.test_only_line_frac_bits_removed = 12;
+  EXPECT_GT(CheckPatch(patch, Basis::kBSpline, 1024, 1024, weakened), 0);
+}
+
 TEST(PatchEngine, ChoosesTheNarrowestAccumulator) {
   std::mt19937_64 rng(13);
   const RawPatch patch = RandomPatch(rng, Basis::kBezier, 2000);
@@ -241,8 +308,19 @@ TEST(PatchEngine, ChoosesTheNarrowestAccumulator) {
   ASSERT_EQ(Prepare(patch, Basis::kBezier, 64, 64, &prepared), Status::kOk);
   EXPECT_EQ(prepared.format.acc_bits, 64);
   EXPECT_EQ(prepared.format.frac_bits, RequiredFracBits(64, 64));
+  EXPECT_EQ(prepared.s_line_frac_bits, 0);  // no per-line rounding for a 64-bit table
+  EXPECT_EQ(prepared.t_line_frac_bits, 0);
   ASSERT_EQ(Prepare(patch, Basis::kBezier, 1024, 1024, &prepared), Status::kOk);
   EXPECT_EQ(prepared.format.acc_bits, 128);
+}
+
+TEST(PrecisionPlanner, RequiredLineFracBitsMatchTheDerivation) {
+  // bitlength(S(n)) + 7: S(1024) = 178 957 825 < 2^28, S(256) = 2 796 417 < 2^22,
+  // S(40) = 10 701 < 2^14.
+  EXPECT_EQ(RequiredLineFracBits(1024), 28 + 7);
+  EXPECT_EQ(RequiredLineFracBits(256), 22 + 7);
+  EXPECT_EQ(RequiredLineFracBits(40), 14 + 7);
+  EXPECT_EQ(RequiredLineFracBits(1), 2 + 7);
 }
 
 TEST(PrecisionPlanner, RequiredFracBitsMatchTheDerivation) {

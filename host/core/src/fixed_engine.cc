@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "fdsurf/host/fixed_engine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -91,8 +92,20 @@ double ErrorBoundBeforeRounding(const PreparedPatch<3>& patch, Basis basis) {
   const double stepping = patch.exact ? 0.0
                                       : propagation(patch.steps_s) * propagation(patch.steps_t) *
                                             std::ldexp(1.0, -(patch.format.frac_bits + 1));
+  // Per-line rounding: each of a line's 4 entries off by at most half a unit
+  // of its format, propagated over the line's steps.
+  double line = 0;
+  if (patch.format.acc_bits != 64) {
+    if (patch.s_line_frac_bits != 0) {
+      line = propagation(patch.steps_t) * std::ldexp(1.0, -(patch.s_line_frac_bits + 1));
+    }
+    if (patch.t_line_frac_bits != 0) {
+      line = std::max(line,
+                      propagation(patch.steps_s) * std::ldexp(1.0, -(patch.t_line_frac_bits + 1)));
+    }
+  }
   const double conversion = LebesgueConstant(basis) * (std::ldexp(1.0, -17) + std::ldexp(1.0, -20));
-  return stepping + conversion;
+  return stepping + line + conversion;
 }
 
 }  // namespace fdsurf::host

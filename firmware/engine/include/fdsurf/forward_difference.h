@@ -32,6 +32,12 @@ constexpr uint16_t kMaxCurveSteps = 65535;
 /// the difference table exactly ≤ 1 quantum; 9 makes it ≤ 2^-10 quanta.
 constexpr int kGuardBits = 9;
 
+/// Guard bits of a line's own format under per-line rounding
+/// (LinePatchStepper): re-rounding a line's 4 entries then adds at most
+/// 2^-(kLineGuardBits+1) quanta to its points (docs/precision.md, "Per-line
+/// rounding"; 2^-8 ≈ 0.0039, inside the 0.51-quantum budget).
+constexpr int kLineGuardBits = 7;
+
 /// The runtime format of the differences: accumulator width and the number of
 /// fractional bits (values are integers in units of 2^-frac_bits quanta).
 struct DiffFormat {
@@ -47,6 +53,8 @@ struct PrepareOptions {
   /// Removes fractional bits from the planned format. Exists so tests can show
   /// that the bound fails without them; production code leaves it at 0.
   uint8_t test_only_frac_bits_removed = 0;
+  /// The same for the per-line formats (PreparedPatch::s_line_frac_bits).
+  uint8_t test_only_line_frac_bits_removed = 0;
 };
 
 /// One coordinate of a curve's geometry: the 4 basis coefficients
@@ -79,12 +87,23 @@ struct PreparedPatch {
   uint16_t steps_s;
   uint16_t steps_t;
   bool exact;
+  /// Per-line rounding (docs/precision.md, "Per-line rounding"), planned
+  /// only when `format` needs the 128-bit accumulator: the fractional bits
+  /// of the 64-bit line stepper of LinePatchStepper along s-lines (stepping
+  /// t) and along t-lines (stepping s); 0 when such a line does not fit 64
+  /// bits, or when `format` is 64-bit already.
+  uint8_t s_line_frac_bits;
+  uint8_t t_line_frac_bits;
   Int128 dd[kDims][4][4];
 };
 
 /// The fractional bits that make the stepping error ≤ 2^-(kGuardBits+1)
 /// quanta for `steps_s` × `steps_t` steps (steps_t = 0 for a curve).
 int RequiredFracBits(uint32_t steps_s, uint32_t steps_t);
+
+/// The fractional bits of a line of `steps` steps under per-line rounding:
+/// bitlength(S(steps)) + kLineGuardBits.
+int RequiredLineFracBits(uint32_t steps);
 
 /// Plans and sets up one curve coordinate by coordinate.
 /// Errors: kInvalidArgument (unknown basis, kDims out of 1..3),
@@ -108,6 +127,14 @@ inline void Load(const Int128& from, int64_t* to) {
   *to = static_cast<int64_t>(from.lo);
 }
 inline void Load(const Int128& from, Int128* to) { *to = from; }
+
+/// round(value·2^-shift) as an int64_t, halves up: a table entry of the
+/// wide format moved to a line's format, `shift` = 1..63 bits fewer. The
+/// planner proved that the result fits (docs/precision.md).
+inline int64_t RoundToLine(const Int128& value, int shift) {
+  const Int128 biased = value + Int128{uint64_t{1} << (shift - 1), 0};
+  return static_cast<int64_t>(ShiftRightArithmetic(biased, shift).lo);
+}
 
 /// The row-add update of one difference vector: advance one step.
 template <typename Acc>
@@ -236,6 +263,87 @@ class PatchStepper {
   int frac_bits_;
   uint16_t steps_s_;
   uint16_t steps_t_;
+};
+
+/// Steps a prepared patch whose table needs the 128-bit accumulator with a
+/// 64-bit inner loop (docs/precision.md, "Per-line rounding"): the outer
+/// direction is stepped in the wide format, and at each line its difference
+/// vector is rounded once to the line's own format (s_line_frac_bits or
+/// t_line_frac_bits, which must be non-zero for the family stepped) and
+/// stepped in int64_t. Every point is within 0.51 quanta of the exact patch;
+/// s-lines and t-lines may differ by a quantum where the exact value is
+/// within about 0.002 quanta of a half (they round different lines).
+template <int kDims>
+class LinePatchStepper {
+ public:
+  explicit LinePatchStepper(const PreparedPatch<kDims>& patch) : patch_(patch) {}
+
+  /// As PatchStepper::ForEachSLinePoint; needs patch.s_line_frac_bits.
+  template <typename Sink>
+  void ForEachSLinePoint(Sink&& sink) const {
+    Int128 dd[kDims][4][4];
+    Copy(dd);
+    const int line_bits = patch_.s_line_frac_bits;
+    const int shift = patch_.format.frac_bits - line_bits;
+    int64_t line[kDims][4];
+    int32_t point[kDims];
+    for (uint32_t i = 0;; ++i) {
+      for (int c = 0; c < kDims; ++c) {
+        for (int l = 0; l < 4; ++l) line[c][l] = internal::RoundToLine(dd[c][0][l], shift);
+      }
+      for (uint32_t j = 0;; ++j) {
+        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], line_bits);
+        sink(i, j, point);
+        if (j == patch_.steps_t) break;
+        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      }
+      if (i == patch_.steps_s) break;
+      for (int c = 0; c < kDims; ++c) {
+        for (int l = 0; l < 4; ++l) {
+          dd[c][0][l] += dd[c][1][l];
+          dd[c][1][l] += dd[c][2][l];
+          dd[c][2][l] += dd[c][3][l];
+        }
+      }
+    }
+  }
+
+  /// As PatchStepper::ForEachTLinePoint; needs patch.t_line_frac_bits.
+  template <typename Sink>
+  void ForEachTLinePoint(Sink&& sink) const {
+    Int128 dd[kDims][4][4];
+    Copy(dd);
+    const int line_bits = patch_.t_line_frac_bits;
+    const int shift = patch_.format.frac_bits - line_bits;
+    int64_t line[kDims][4];
+    int32_t point[kDims];
+    for (uint32_t j = 0;; ++j) {
+      for (int c = 0; c < kDims; ++c) {
+        for (int k = 0; k < 4; ++k) line[c][k] = internal::RoundToLine(dd[c][k][0], shift);
+      }
+      for (uint32_t i = 0;; ++i) {
+        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], line_bits);
+        sink(i, j, point);
+        if (i == patch_.steps_s) break;
+        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      }
+      if (j == patch_.steps_t) break;
+      for (int c = 0; c < kDims; ++c) {
+        for (int k = 0; k < 4; ++k) internal::Step(dd[c][k]);
+      }
+    }
+  }
+
+ private:
+  void Copy(Int128 (&to)[kDims][4][4]) const {
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) {
+        for (int l = 0; l < 4; ++l) to[c][k][l] = patch_.dd[c][k][l];
+      }
+    }
+  }
+
+  const PreparedPatch<kDims>& patch_;
 };
 
 }  // namespace fdsurf

@@ -21,12 +21,16 @@ namespace fdsurf::host {
 PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, int steps_s,
                                    int steps_t, const PrepareOptions& options = {});
 
-/// Steps a prepared patch along s-lines (the grid, i-major), picking the
-/// accumulator the plan chose. sink(i, j, const int32_t (&)[3]).
+/// Steps a prepared patch along s-lines (the grid, i-major) with a 64-bit
+/// inner loop where the plan allows it: the table's own accumulator when it
+/// is 64-bit, else the per-line rounding (LinePatchStepper) when the lines
+/// fit 64 bits, else the 128-bit accumulator. sink(i, j, const int32_t (&)[3]).
 template <typename Sink>
 void ForEachGridPoint(const PreparedPatch<3>& patch, Sink&& sink) {
   if (patch.format.acc_bits == 64) {
     PatchStepper<std::int64_t, 3>(patch).ForEachSLinePoint(sink);
+  } else if (patch.s_line_frac_bits != 0) {
+    LinePatchStepper<3>(patch).ForEachSLinePoint(sink);
   } else {
     PatchStepper<Int128, 3>(patch).ForEachSLinePoint(sink);
   }
@@ -37,15 +41,20 @@ template <typename Sink>
 void ForEachTLinePoint(const PreparedPatch<3>& patch, Sink&& sink) {
   if (patch.format.acc_bits == 64) {
     PatchStepper<std::int64_t, 3>(patch).ForEachTLinePoint(sink);
+  } else if (patch.t_line_frac_bits != 0) {
+    LinePatchStepper<3>(patch).ForEachTLinePoint(sink);
   } else {
     PatchStepper<Int128, 3>(patch).ForEachTLinePoint(sink);
   }
 }
 
 /// A rigorous a-priori bound (in quanta) of |fixed − exact| before the final
-/// rounding to whole quanta, for this basis and grid: the stepping term
-/// S(n)·S(m)·2^-(F+1) plus the geometry conversion term L·(2^-17 + 2^-20)
-/// (docs/precision.md). The emitted positions are within 0.5 + this.
+/// rounding to whole quanta, for this basis and grid, as ForEachGridPoint and
+/// ForEachTLinePoint step it: the stepping term S(n)·S(m)·2^-(F+1), the
+/// per-line rounding term S(line steps)·2^-(F_line+1) when a family uses it
+/// (the larger of the two families'), plus the geometry conversion term
+/// L·(2^-17 + 2^-20) (docs/precision.md). The emitted positions are within
+/// 0.5 + this.
 double ErrorBoundBeforeRounding(const PreparedPatch<3>& patch, Basis basis);
 
 }  // namespace fdsurf::host
