@@ -16,33 +16,37 @@ namespace image {
 
 constexpr int kRomNameSize = 16;
 
+// The indices are bytes: the small set has far fewer than 256 items of a
+// kind (the emitted initializers would not compile otherwise, as narrowing),
+// and the ATmega328P's 32 KB of flash has no byte to spare.
+
 struct RomPatch2 {
   char name[kRomNameSize];
-  uint16_t index;
+  uint8_t index;
   Status status;
   PreparedPatch<2> prepared;
 };
 struct RomCurve2 {
   char name[kRomNameSize];
-  uint16_t index;
+  uint8_t index;
   Status status;
   PreparedCurve<2> prepared;
 };
 struct RomCurve3 {
   char name[kRomNameSize];
-  uint16_t index;
+  uint8_t index;
   Status status;
   PreparedCurve<3> prepared;
 };
 struct RomAdaptive2 {
   char name[kRomNameSize];
-  uint16_t index;
+  uint8_t index;
   Status status;
   PreparedAdaptiveCurve<2> prepared;
 };
 struct RomCoefficients2 {
   char name[kRomNameSize];
-  uint16_t index;
+  uint8_t index;
   PowerCurve1 curve[2];
 };
 
@@ -51,7 +55,7 @@ enum class RomKind : uint8_t { kPatch2, kCurve2, kCurve3, kAdaptive2, kCoefficie
 /// The small set in the order the host reference prints it.
 struct RomItem {
   RomKind kind;
-  uint16_t index;  // into the array of that kind
+  uint8_t index;  // into the array of that kind
 };
 
 extern const RomPatch2 kRomPatch2[] FDSURF_IMAGE_ROM;
