@@ -546,29 +546,35 @@ def parse():
     return args
 
 
-def main():
-    args = parse()
-    workdir = args.workdir or tempfile.mkdtemp(prefix="fdsurf-e2e-%s-%s-" % (args.board,
-                                                                             args.scenario))
+def run_in_workdir(run_scenario, args, given_workdir, prefix, name):
+    """Runs `run_scenario(args, processes)` in `given_workdir` or a temporary
+    folder, with every process stopped on the way out: 0 and the temporary
+    folder removed when it passed, 1 with the processes' log tails and the
+    folder kept for its files when it failed. `name` heads the verdict."""
+    workdir = given_workdir or tempfile.mkdtemp(prefix=prefix)
     os.makedirs(workdir, exist_ok=True)
     processes = Processes(workdir)
     try:
-        run(args, processes)
+        run_scenario(args, processes)
         processes.stop_all()
-        print("run_e2e: %s %s: PASS" % (args.board, args.scenario))
-        # A temporary folder goes when the run passed; one that failed stays for its files.
-        if not args.workdir:
+        print("%s: PASS" % name)
+        if not given_workdir:
             shutil.rmtree(workdir, ignore_errors=True)
         return 0
     except Failure as failure:
         processes.stop_all()
         processes.print_tails()
-        print("run_e2e: %s %s: FAIL: %s (files in %s)" % (args.board, args.scenario, failure,
-                                                           workdir))
+        print("%s: FAIL: %s (files in %s)" % (name, failure, workdir))
         return 1
     finally:
         processes.stop_all()
 
+
+def main():
+    args = parse()
+    return run_in_workdir(run, args, args.workdir,
+                          "fdsurf-e2e-%s-%s-" % (args.board, args.scenario),
+                          "run_e2e: %s %s" % (args.board, args.scenario))
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -35,9 +35,7 @@ the firmware. Every process runs under a timeout. Exit 0 pass, 1 fail.
 import argparse
 import os
 import re
-import shutil
 import sys
-import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -197,25 +195,8 @@ def main():
     args = parser.parse_args()
     if args.start is None:
         args.start = "-40,10" if args.scenario == "hardlimit" else "300,200"
-    workdir = args.workdir or tempfile.mkdtemp(prefix="fdsurf-homing-e2e-")
-    os.makedirs(workdir, exist_ok=True)
-    processes = run_e2e.Processes(workdir)
-    try:
-        run(args, processes)
-        processes.stop_all()
-        print("run_homing_e2e: PASS")
-        # A temporary folder goes when the run passed; one that failed stays for its files.
-        if not args.workdir:
-            shutil.rmtree(workdir, ignore_errors=True)
-        return 0
-    except Failure as failure:
-        processes.stop_all()
-        processes.print_tails()
-        print("run_homing_e2e: FAIL: %s (files in %s)" % (failure, workdir))
-        return 1
-    finally:
-        processes.stop_all()
-
+    return run_e2e.run_in_workdir(run, args, args.workdir, "fdsurf-homing-e2e-",
+                                  "run_homing_e2e")
 
 if __name__ == "__main__":
     sys.exit(main())
