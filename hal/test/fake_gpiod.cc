@@ -122,6 +122,9 @@ int __wrap_gpiod_line_set_value_bulk(gpiod_line_bulk* bulk, const int* values) {
     return -1;
   }
   for (unsigned i = 0; i < bulk->num_lines; ++i) Line(bulk->lines[i])->value = values[i];
+  for (unsigned i = 0; i < bulk->num_lines && g_fake_gpio->on_set; ++i) {
+    g_fake_gpio->on_set(Line(bulk->lines[i])->offset, values[i]);
+  }
   return 0;
 }
 
@@ -140,6 +143,7 @@ int __wrap_gpiod_line_set_value(gpiod_line* line, int value) {
     return -1;
   }
   Line(line)->value = value;
+  if (g_fake_gpio->on_set) g_fake_gpio->on_set(Line(line)->offset, value);
   return 0;
 }
 

@@ -7,6 +7,7 @@
 
 #include <stdint.h>
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -47,6 +48,9 @@ struct FakeGpio {
   std::vector<uint64_t> set_times_us;
   /// The number the next request gets.
   int next_request = 1;
+  /// Called after every output value a set stores (line offset, the level
+  /// written), e.g. to move a simulated carriage; none by default.
+  std::function<void(unsigned, int)> on_set;
 
   /// A chip with `count` unused lines, opened by `descriptor`.
   FakeGpioChip& AddChip(const std::string& descriptor, unsigned count);

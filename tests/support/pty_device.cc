@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // A serial device for tests, on a real kernel pseudo-terminal: the firmware's
 // Device<2> runs here on the pty's master side and the slave is published
-// under a stable symlink, which the host opens as `serial:LINK`.
+// under a stable symlink (hal/linux pty_transport.h, as `fdsurf serve`
+// publishes itself), which the host opens as `serial:LINK`.
 //
 //   pty_device --link PATH [--report FILE] [--tick-hz 20000] [--speedup 1]
 //              [--silent-ms N] [--never-answer] [--hangup-after-bytes N]
@@ -35,12 +36,7 @@
 // SIGUSR1 it writes the report as it is now and goes on (a snapshot, e.g.
 // while the host pauses between layers). The report is renamed into place,
 // so a reader never sees half of one.
-#include <fcntl.h>
-#include <poll.h>
-#include <pty.h>
 #include <signal.h>
-#include <termios.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdint>
@@ -51,11 +47,13 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "fdsurf/device/device.h"
 #include "fdsurf/hal/inputs.h"
 #include "fdsurf/hal/outputs.h"
+#include "fdsurf/hal/pty_transport.h"
 
 namespace {
 
@@ -215,38 +213,6 @@ bool ParseOptions(int argc, char** argv, Options* o) {
   return true;
 }
 
-// One pty, its slave kept open here too (so the master never sees the host's
-// close as a hang-up), published at `link` by an atomic rename.
-struct Pty {
-  int master = -1;
-  int slave = -1;
-
-  bool Open(const std::string& link) {
-    char name[128];
-    if (openpty(&master, &slave, name, nullptr, nullptr) != 0) {
-      std::perror("pty_device: openpty");
-      return false;
-    }
-    termios tio{};
-    tcgetattr(slave, &tio);
-    cfmakeraw(&tio);
-    tcsetattr(slave, TCSANOW, &tio);
-    fcntl(master, F_SETFL, fcntl(master, F_GETFL) | O_NONBLOCK);
-    const std::string temporary = link + ".new";
-    unlink(temporary.c_str());
-    if (symlink(name, temporary.c_str()) != 0 || rename(temporary.c_str(), link.c_str()) != 0) {
-      std::perror("pty_device: publishing the link");
-      return false;
-    }
-    return true;
-  }
-  void Close() {
-    if (slave >= 0) close(slave);
-    if (master >= 0) close(master);
-    master = slave = -1;
-  }
-};
-
 using Clock = std::chrono::steady_clock;
 
 long MsSince(Clock::time_point t) {
@@ -259,7 +225,7 @@ struct Run {
   std::optional<fdsurf::device::Device<2>> device;  // rebuilt by a power cut
   RecordingOutputs outputs;
   MinSwitches switches{outputs, o.endstop_offset};
-  Pty pty;
+  std::unique_ptr<fdsurf::hal::PtyTransport> pty;  // none while hung up or powered off
   long bytes_in = 0;
   bool heard = false;  // a first byte arrived: the "reset" happened
   Clock::time_point first_byte;
@@ -277,8 +243,7 @@ struct Run {
 
   // SIGUSR2: the device loses power (see the top of the file).
   void PowerCut() {
-    pty.Close();
-    unlink(o.link.c_str());
+    pty.reset();  // the link goes with it
     down = true;
     down_since = Clock::now();
     outputs.pen_down = false;
@@ -287,11 +252,26 @@ struct Run {
     PowerOn();
   }
 
-  // Bytes in from the host, replies out.
+  // Publishes a new pty at the link: false (said why) when it cannot.
+  bool OpenPty() {
+    std::string error;
+    if (fdsurf::hal::PtyTransport::Open(o.link, &pty, &error) == fdsurf::hal::IoStatus::kOk) {
+      return true;
+    }
+    std::fprintf(stderr, "pty_device: %s\n", error.c_str());
+    return false;
+  }
+
+  // Bytes in from the host (waiting up to 1 ms for the first), replies out.
   void Service() {
     uint8_t buffer[256];
-    const ssize_t n = pty.master >= 0 ? read(pty.master, buffer, sizeof buffer) : -1;
-    for (ssize_t i = 0; i < n; ++i) {
+    size_t n = 0;
+    if (pty) {
+      (void)pty->Read(buffer, sizeof buffer, &n, 1);
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    for (size_t i = 0; i < n; ++i) {
       if (!heard) {
         heard = true;
         first_byte = Clock::now();
@@ -300,19 +280,18 @@ struct Run {
       const bool silent = o.never_answer || MsSince(first_byte) < o.silent_ms;
       if (!silent) device->OnByte(buffer[i]);
       if (o.hangup_after_bytes >= 0 && bytes_in == o.hangup_after_bytes && !down) {
-        pty.Close();
-        unlink(o.link.c_str());
+        pty.reset();  // the host sees a hang-up; the link goes with it
         down = true;
         down_since = Clock::now();
         break;
       }
     }
     for (size_t got; (got = device->ReadOutput(buffer, sizeof buffer)) > 0;) {
-      if (pty.master >= 0) (void)!write(pty.master, buffer, got);
+      if (pty) (void)pty->Write(buffer, got, 0);  // what the pty cannot take is lost, as on a wire
     }
     if (down && MsSince(down_since) >= o.back_after_ms) {
       down = false;
-      if (!pty.Open(o.link)) g_quit = 1;
+      if (!OpenPty()) g_quit = 1;
     }
   }
 
@@ -371,14 +350,12 @@ int main(int argc, char** argv) {
   sigaction(SIGUSR2, &power_cut, nullptr);
   signal(SIGPIPE, SIG_IGN);
   auto run = std::make_unique<Run>(o);
-  if (!run->pty.Open(o.link)) return 1;
+  if (!run->OpenPty()) return 1;
   std::printf("ready\n");
   std::fflush(stdout);
   const Clock::time_point start = Clock::now();
   while (g_quit == 0 &&
          std::chrono::duration<double>(Clock::now() - start).count() < o.time_limit_s) {
-    pollfd p{run->pty.master, POLLIN, 0};
-    (void)poll(&p, run->pty.master >= 0 ? 1 : 0, 1);
     run->Service();
     run->device->Fill();
     run->Tick(start);
@@ -392,7 +369,6 @@ int main(int argc, char** argv) {
     }
   }
   run->Report();
-  run->pty.Close();
-  unlink(o.link.c_str());
+  run->pty.reset();
   return 0;
 }

@@ -15,6 +15,7 @@
 #include "machine/machine_command.h"
 #include "machine/manual_command.h"
 #include "machine/profile.h"
+#include "serve/serve_command.h"
 #include "stream_command.h"
 
 namespace fdsurf::host {
@@ -31,6 +32,7 @@ struct Commands {
   PortsOptions ports_options;
   MachineShowOptions machine_show_options;
   ManualOptions manual_options;
+  ServeOptions serve_options;
   std::string manual_action;  // home, jog, ... when one was parsed
   /// --machine of stream and plot (machine/profile.h).
   std::string stream_machine;
@@ -44,6 +46,7 @@ struct Commands {
   CLI::App* ports = nullptr;
   CLI::App* machine = nullptr;
   CLI::App* machine_show = nullptr;
+  CLI::App* serve = nullptr;
 };
 
 void AddCommands(CLI::App* app, Commands* c) {
@@ -87,6 +90,11 @@ void AddCommands(CLI::App* app, Commands* c) {
       "show", "Print the effective machine settings and where each came from.");
   AddMachineShowOptions(c->machine_show, &c->machine_show_options);
   AddManualCommands(c->machine, &c->manual_options, &c->manual_action);
+  c->serve = app->add_subcommand(
+      "serve",
+      "Be the board of a machine on this host's GPIO lines: the device runs here and serves the "
+      "protocol on a pty, for --device serial:PATH (docs/machines.md).");
+  AddServeOptions(c->serve, &c->serve_options);
 }
 
 // CLI11 would only say "a subcommand is required" for a mistyped command.
@@ -94,7 +102,8 @@ bool IsUnknownCommand(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return false;
   const std::string first = argv[1];
   return first != "sample" && first != "check" && first != "plot" && first != "render" &&
-         first != "stream" && first != "joins" && first != "ports" && first != "machine";
+         first != "stream" && first != "joins" && first != "ports" && first != "machine" &&
+         first != "serve";
 }
 
 // Runs the parsed command; the library's errors become messages and exit
@@ -104,6 +113,7 @@ int RunParsed(Commands& c) {
   try {
     if (c.plot->parsed()) ApplyMachineOption(c.plot_machine, c.plot);
     if (c.stream->parsed()) ApplyMachineOption(c.stream_machine, c.stream);
+    if (c.serve->parsed()) ApplyMachineOption(c.serve_options.machine, c.serve);
     if (c.sample->parsed()) return RunSample(c.sample_options);
     if (c.check->parsed()) return RunCheck(c.check_options);
     if (c.plot->parsed()) return RunPlot(c.plot_options, false);
@@ -113,6 +123,7 @@ int RunParsed(Commands& c) {
     if (c.ports->parsed()) return RunPorts(c.ports_options);
     if (c.machine_show->parsed()) return RunMachineShow(c.machine_show_options);
     if (!c.manual_action.empty()) return RunManual(c.manual_action, c.manual_options);
+    if (c.serve->parsed()) return RunServe(c.serve_options);
   } catch (const OptionError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.MessageFor(FlagFor(e.field())).c_str());
     return 2;
@@ -142,7 +153,7 @@ int Main(int argc, char** argv) {
     std::fprintf(
         stderr,
         "fdsurf: error: unknown command '%s' (expected sample, check, plot, render, stream, "
-        "joins, ports or machine)\n",
+        "joins, ports, machine or serve)\n",
         argv[1]);
     return 2;
   }

@@ -18,6 +18,7 @@
 #include "../runners/runner.h"
 #include "../runners/serial_session.h"
 #include "../runners/usb_session.h"
+#include "../serve/serve_command.h"
 #include "../stream_command.h"
 #include "fdsurf/hal/serial_transport.h"
 #include "fdsurf/host/errors.h"
@@ -226,9 +227,10 @@ std::unique_ptr<Connection> Connect(const Settings& s) {
   }
   if (device.rfind("gpio:", 0) == 0) {
     throw InputError("--device " + device +
-                     ": machine commands do not run on gpio devices yet: the tool is the "
-                     "controller there, and nothing holds the position once it exits "
-                     "(docs/machines.md)");
+                     ": the lines are driven by `fdsurf serve`, which holds the position between "
+                     "commands: start `fdsurf serve --device " +
+                     device + "` and give these commands --device serial:" + DefaultServeLink() +
+                     " (docs/machines.md)");
   }
   throw InputError("--device " + device +
                    ": machine commands run on sim, usb[:VID:PID|:BUS-PORT] and serial:PATH "

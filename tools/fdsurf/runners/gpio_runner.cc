@@ -7,97 +7,30 @@
 
 #include "../cli_options.h"
 #include "fdsurf/device/device.h"
-#include "fdsurf/hal/gpiod_inputs.h"
-#include "fdsurf/hal/gpiod_outputs.h"
 #include "fdsurf/hal/monotonic_clock.h"
-#include "fdsurf/hal/pwm.h"
-#include "fdsurf/hal/sysfs_pwm.h"
 #include "fdsurf/hal/tick_scheduler.h"
+#include "gpio_lines.h"
 #include "runner.h"
 #include "tick_loop.h"
 
 namespace fdsurf::host {
 namespace {
 
-// A servo pen on a PWM channel of the kernel (the PEN field pwmN.M of
-// --device): started with the job's CONFIG widths, lifted on every exit path
-// (the destructor waits two 20 ms periods for the up pulse to go out).
-class PwmServoPen {
- public:
-  PwmServoPen(const hal::GpiodConfig& config, const protocol::MachineConfig& machine) {
-    if (machine.servo_up_us == 0) {
-      throw InputError("--device: the pen is a servo on pwm" + std::to_string(config.pen_pwm_chip) +
-                       "." + std::to_string(config.pen_pwm_channel) +
-                       ": give its pulse widths (--servo-pulse-up, --servo-pulse-down)");
-    }
-    hal::SysfsPwmConfig pwm_config;
-    pwm_config.chip = config.pen_pwm_chip;
-    pwm_config.channel = config.pen_pwm_channel;
-    std::string error;
-    if (hal::SysfsPwm::Open(pwm_config, &pwm_, &error) != hal::IoStatus::kOk) {
-      throw DeviceError(error);
-    }
-    pen_ = std::make_unique<hal::ServoPen>(*pwm_, machine.servo_up_us, machine.servo_down_us);
-    if (pen_->Start() != hal::IoStatus::kOk) throw DeviceError(pen_->LastError());
-  }
-  ~PwmServoPen() {
-    if (static_cast<hal::PenOutput&>(*pen_).SetPen(false) != hal::IoStatus::kOk) return;
-    hal::MonotonicClock clock;
-    clock.SleepUntilMicros(clock.NowMicros() + 2 * hal::kServoPeriodUs);
-  }
-  PwmServoPen(const PwmServoPen&) = delete;
-  PwmServoPen& operator=(const PwmServoPen&) = delete;
-
-  hal::PenOutput& pen() { return *pen_; }
-
- private:
-  std::unique_ptr<hal::SysfsPwm> pwm_;
-  std::unique_ptr<hal::ServoPen> pen_;
-};
-
-// Everything a job on the GPIO lines runs with, apart from the Device. The
-// pen is the pen line of `lines`, or a servo on a PWM channel.
+// Everything a job on the GPIO lines runs with, apart from the Device.
 struct GpioRig {
-  GpioRig(hal::GpiodOutputs& lines, hal::PenOutput& pen_output, std::uint32_t tick_hz, bool quiet)
+  GpioRig(GpioLines& gpio_lines, std::uint32_t tick_hz, bool quiet)
       // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
       : ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz),
         link(LinkOptions()),
-        outputs(lines),
-        pen(pen_output),
+        lines(gpio_lines),
         progress(ShowProgress(quiet)) {}
-
-  // The failed output's detail: the lines', else the pen's, else the
-  // endstops' (a switch that could not be read).
-  FDSURF_NODISCARD std::string OutputError() const {
-    const std::string lines_error = outputs.StepDirOutputs::LastError();
-    if (!lines_error.empty()) return "gpio: " + lines_error;
-    const std::string pen_error = pen.LastError();
-    if (pen_error.empty() && endstops != nullptr) return endstops->LastError();
-    return "gpio: " + pen_error;
-  }
 
   hal::MonotonicClock clock;
   hal::TickScheduler ticks;
   HostLink link;
-  hal::GpiodOutputs& outputs;
-  hal::PenOutput& pen;
-  hal::EndstopInputs* endstops = nullptr;  // the ENDSTOPS of --device, if any
+  GpioLines& lines;
   ProgressLine progress;
 };
-
-// The ENDSTOPS part of --device (hal/gpiod_inputs.h) checked, before any
-// line is opened; no switch when it is left out.
-hal::GpioEndstopConfig EndstopsOf(const hal::GpiodConfig& config) {
-  hal::GpioEndstopConfig endstops;
-  endstops.chip = config.chip;
-  endstops.consumer = config.consumer;
-  std::string error;
-  if (!config.endstops.empty() &&
-      !hal::ParseGpioEndstops(config.endstops, config, &endstops, &error)) {
-    throw InputError("--device: " + error);
-  }
-  return endstops;
-}
 
 // Ticks `device` while `keep_going()`; DeviceError when an output fails.
 template <class Device, class KeepGoing>
@@ -108,9 +41,9 @@ void Tick(GpioRig& rig, Device& device, std::uint64_t total_commands, KeepGoing 
     last_progress = now;
     rig.progress.Show(device.executed(), total_commands, rig.link.stats().frames_sent, 0);
   };
-  if (RunTickLoopWhile(rig.clock, rig.ticks, rig.link, device, rig.outputs, rig.pen, show_progress,
-                       keep_going) != hal::IoStatus::kOk) {
-    throw DeviceError(rig.OutputError());
+  if (RunTickLoopWhile(rig.clock, rig.ticks, rig.link, device, rig.lines.outputs(), rig.lines.pen(),
+                       show_progress, keep_going) != hal::IoStatus::kOk) {
+    throw DeviceError(rig.lines.OutputError());
   }
 }
 
@@ -124,13 +57,12 @@ int HaltNow(const StreamOptions& o, GpioRig& rig, Device& device) {
   const std::uint64_t deadline = rig.clock.NowMicros() + 200'000;
   Tick(rig, device, 0,
        [&] { return !rig.link.HaltAcknowledged() && rig.clock.NowMicros() < deadline; });
-  const bool lifted = rig.outputs.SetPen(false) == hal::IoStatus::kOk;
-  const bool disabled = rig.outputs.SetEnabled(false) == hal::IoStatus::kOk;
+  const GpioLines::SafeState safe = rig.lines.MakeSafe();
   std::fprintf(stderr,
                "fdsurf: halted: gpio %s stopped at once, pen %s, drivers %s (the position may be "
                "lost: home before the next job)\n",
-               o.device.c_str(), lifted ? "lifted" : "NOT lifted",
-               disabled ? "disabled" : "NOT disabled");
+               o.device.c_str(), safe.pen_lifted ? "lifted" : "NOT lifted",
+               safe.drivers_disabled ? "disabled" : "NOT disabled");
   return 130;
 }
 
@@ -182,9 +114,9 @@ int RunLayers(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device
     }
     rig.progress.Finish();
     const auto idle_slice = [&] {
-      if (RunIdleTicks(rig.clock, rig.ticks, link, device, rig.outputs, rig.pen,
+      if (RunIdleTicks(rig.clock, rig.ticks, link, device, rig.lines.outputs(), rig.lines.pen(),
                        std::max<std::uint64_t>(1, tick_hz / 50)) != hal::IoStatus::kOk) {
-        throw DeviceError(rig.OutputError());
+        throw DeviceError(rig.lines.OutputError());
       }
     };
     if (!PauseForLayer(o.no_pause, job, to, device.executed(), idle_slice)) {
@@ -206,39 +138,26 @@ int RunLayers(const StreamOptions& o, const StreamJob& job, GpioRig& rig, Device
 // and resumes it at the speed it had (the device does not know about the
 // stall): a stepper at speed may lose steps there, which the summary reports.
 int RunGpio(const StreamOptions& o, const StreamJob& job) {
-  hal::GpiodConfig config;
-  std::string error;
-  if (!hal::ParseGpioDevice(o.device, &config, &error)) throw InputError("--device: " + error);
-  if (config.axes != o.dims) {
-    throw InputError("--device: " + std::to_string(config.axes) +
-                     " axes of lines given for --dims " + std::to_string(o.dims));
-  }
-  const hal::GpioEndstopConfig endstop_config = EndstopsOf(config);
   const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
+  {
+    // The spec is checked before the speed, as the lines are opened after.
+    hal::GpiodConfig config;
+    std::string error;
+    if (!hal::ParseGpioDevice(o.device, &config, &error)) throw InputError("--device: " + error);
+  }
   CheckSpeedAgainstTicks(job, tick_hz, o);
-  std::unique_ptr<hal::GpiodOutputs> outputs;
-  if (hal::GpiodOutputs::Open(config, &outputs, &error) != hal::IoStatus::kOk) {
-    throw DeviceError(error);
-  }
-  std::unique_ptr<hal::GpiodEndstops> endstops;
-  if (!config.endstops.empty() &&
-      hal::GpiodEndstops::Open(endstop_config, &endstops, &error) != hal::IoStatus::kOk) {
-    throw DeviceError(error);
-  }
-  std::unique_ptr<PwmServoPen> servo;
-  if (!config.has_pen_line) servo = std::make_unique<PwmServoPen>(config, job.config);
+  GpioLines lines(o.device, o.dims, job.config.servo_up_us, job.config.servo_down_us);
   const InterruptGuard interrupts;
-  GpioRig rig(*outputs, servo ? servo->pen() : *outputs, tick_hz, o.quiet);
+  GpioRig rig(lines, tick_hz, o.quiet);
   rig.progress.SetSchedule(o.schedule.get());
-  rig.endstops = endstops.get();
   int code = 0;
   if (o.dims == 3) {
     auto device = std::make_unique<device::Device<3>>(tick_hz);
-    device->set_endstops(rig.endstops);
+    device->set_endstops(lines.endstops());
     code = RunLayers(o, job, rig, *device, tick_hz);
   } else {
     auto device = std::make_unique<device::Device<2>>(tick_hz);
-    device->set_endstops(rig.endstops);
+    device->set_endstops(lines.endstops());
     code = RunLayers(o, job, rig, *device, tick_hz);
   }
   if (code != 0 || o.quiet) return code;
