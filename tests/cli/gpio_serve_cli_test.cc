@@ -29,6 +29,10 @@ using Clock = std::chrono::steady_clock;
 using fdsurf::test_support::RunResult;
 using fdsurf::test_support::Slurp;
 
+// The lines gpio_serve_fake.cc serves, as its --device.
+const std::string kLines = "gpio:gpiochip0:0,1,2,3,4,5:xmin=!6,ymin=!7";
+const std::string kLinesArg = "'" + kLines + "'";  // for the shell
+
 double SecondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -258,15 +262,40 @@ TEST_F(GpioServe, BadDevicesAndLinksAreRefusedBeforeAnythingOpens) {
       << ServerErr();
 }
 
-// The machine commands name the way to a gpio machine instead of guessing
-// a position that nothing held.
-TEST_F(GpioServe, MachineCommandsOnGpioPointAtServe) {
-  const RunResult r = Run("machine where --travel 100x80 --device gpio:gpiochip0:1,2,3,4,5,6");
+// Without a server, the machine commands name the way to a gpio machine
+// instead of guessing a position that nothing held.
+TEST_F(GpioServe, MachineCommandsOnGpioWithoutAServerPointAtServe) {
+  setenv("XDG_RUNTIME_DIR", dir_.c_str(), 1);
+  const RunResult r = Run("machine where --travel 100x80 --device " + kLinesArg);
+  unsetenv("XDG_RUNTIME_DIR");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.err.find("start `fdsurf serve --device gpio:gpiochip0:1,2,3,4,5,6` and give these "
-                       "commands --device serial:"),
-            std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("start `fdsurf serve --device " + kLines + "`"), std::string::npos) << r.err;
+}
+
+// With a server publishing those lines at the default link
+// ($XDG_RUNTIME_DIR/fdsurf-gpio), `--device gpio:…` (as a profile would
+// give it) goes through the server: machine commands and a journalled job.
+TEST_F(GpioServe, GpioDevicesGoThroughTheServerThatHoldsThem) {
+  setenv("XDG_RUNTIME_DIR", dir_.c_str(), 1);
+  StartServer("800,400");
+  EXPECT_EQ(Slurp(link_ + ".device"), kLines + "\n");
+  const std::string gpio = " --travel 100x80 --device " + kLinesArg;
+  RunResult r = Run("machine home --rate 40 --backoff 1" + gpio);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("fdsurf: " + kLines + " is served at " + link_), std::string::npos) << r.err;
+  const std::string gcode = Write("zigzag.gcode", Zigzag());
+  const std::string journal = (dir_ / "job.journal").string();
+  r = Run("stream '" + gcode + "' --view top --fit none --speed 80 --require-homing --journal '" +
+          journal + "'" + gpio);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(Slurp(journal).find("executed 34\n"), std::string::npos) << Slurp(journal);
+  r = Run("machine where" + gpio);
+  EXPECT_NE(r.out.find("homed xy"), std::string::npos) << r.out;
+  auto report = StopServer();
+  unsetenv("XDG_RUNTIME_DIR");
+  EXPECT_EQ(report["exit_code"], "0") << ServerErr();
+  EXPECT_NE(report["drawn_points"], "0");
+  EXPECT_FALSE(fs::exists(link_ + ".device")) << "the note outlived the server";
 }
 
 }  // namespace

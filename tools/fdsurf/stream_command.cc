@@ -18,6 +18,7 @@
 #include "runners/machine_schedule.h"
 #include "runners/runner.h"
 #include "runners/serial_session.h"
+#include "serve/serve_command.h"
 
 namespace fdsurf::host {
 namespace {
@@ -333,6 +334,16 @@ int RunStream(const StreamOptions& options) {
   // Messages name standard input "<stdin>", as the reader does.
   StreamOptions o = options;
   if (o.file == "-") o.file = "<stdin>";
+  if (DeviceKindOf(o.device) == DeviceKind::kGpio && !o.dry_run) {
+    // A running `fdsurf serve` holds these lines: through it, as a board.
+    const std::string served = ServedGpioLink(o.device);
+    if (!served.empty()) {
+      if (!o.quiet) {
+        std::fprintf(stderr, "fdsurf: %s is served at %s\n", o.device.c_str(), served.c_str());
+      }
+      o.device = "serial:" + served;
+    }
+  }
   const bool sim = DeviceKindOf(o.device) == DeviceKind::kSim;
   if (DeviceKindOf(o.device) == DeviceKind::kUnknown) {
     throw InputError("--device: '" + o.device +
@@ -345,7 +356,7 @@ int RunStream(const StreamOptions& options) {
       (o.dry_run || (device_kind != DeviceKind::kUsb && device_kind != DeviceKind::kSerial))) {
     throw InputError(
         "--journal and --resume are for --device usb and serial, whose device keeps its state "
-        "when the tool stops (not sim or gpio, nor --dry-run)");
+        "when the tool stops (not sim, nor --dry-run; gpio through `fdsurf serve`)");
   }
   if (!sim && ((drawing_out && !o.dry_run) || o.faults > 0 || o.sim_cost != "none")) {
     throw InputError(

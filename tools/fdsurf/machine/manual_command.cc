@@ -68,6 +68,12 @@ Settings Resolve(const ManualOptions& o) {
     s.profile = LoadMachineProfile(FindMachineProfile(o.machine));
     ApplyMachineProfile(s.profile, stream);
   }
+  const std::string served = ServedGpioLink(s.stream.device);
+  if (!served.empty()) {
+    if (!o.quiet)
+      std::fprintf(stderr, "fdsurf: %s is served at %s\n", s.stream.device.c_str(), served.c_str());
+    s.stream.device = "serial:" + served;
+  }
   s.machine = StreamMachine(s.stream);
   if (!(s.machine.travel[0] > 0)) {
     throw InputError(
@@ -227,10 +233,11 @@ std::unique_ptr<Connection> Connect(const Settings& s) {
   }
   if (device.rfind("gpio:", 0) == 0) {
     throw InputError("--device " + device +
-                     ": the lines are driven by `fdsurf serve`, which holds the position between "
-                     "commands: start `fdsurf serve --device " +
-                     device + "` and give these commands --device serial:" + DefaultServeLink() +
-                     " (docs/machines.md)");
+                     ": nothing holds this machine's position between commands: start `fdsurf "
+                     "serve --device " +
+                     device +
+                     "` (it drives the lines and holds the machine while it runs; "
+                     "docs/machines.md), then run this again");
   }
   throw InputError("--device " + device +
                    ": machine commands run on sim, usb[:VID:PID|:BUS-PORT] and serial:PATH "

@@ -4,6 +4,8 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -109,6 +111,23 @@ int ServeUntilSignalled(const ServeOptions& o, Server& server, std::uint32_t tic
   return 3;
 }
 
+// LINK.device: which --device a server publishes at LINK, written beside
+// the link (renamed into place) while it serves, removed when it stops.
+class ServedDeviceNote {
+ public:
+  ServedDeviceNote(const std::string& link, const std::string& device) : path_(link + ".device") {
+    const std::string temporary = path_ + ".new";
+    std::ofstream(temporary) << device << "\n";
+    std::rename(temporary.c_str(), path_.c_str());
+  }
+  ~ServedDeviceNote() { std::remove(path_.c_str()); }
+  ServedDeviceNote(const ServedDeviceNote&) = delete;
+  ServedDeviceNote& operator=(const ServedDeviceNote&) = delete;
+
+ private:
+  std::string path_;
+};
+
 std::uint16_t ServoWidth(int us, const char* flag) {
   if (us != 0 && (us < 500 || us > 2500)) {
     throw InputError(std::string(flag) + ": " + std::to_string(us) +
@@ -123,6 +142,18 @@ std::string DefaultServeLink() {
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
   const std::string dir = runtime != nullptr && runtime[0] == '/' ? runtime : "/tmp";
   return dir + "/fdsurf-gpio";
+}
+
+std::string ServedGpioLink(const std::string& device) {
+  const std::string link = DefaultServeLink();
+  std::ifstream note(link + ".device");
+  std::string served;
+  std::getline(note, served);
+  // The link must lead to a live pty: a server killed outright leaves both
+  // behind, and its /dev/pts/N may be gone.
+  std::error_code error;
+  if (served != device || !std::filesystem::exists(link, error)) return "";
+  return link;
 }
 
 void AddServeOptions(CLI::App* command, ServeOptions* o) {
@@ -154,6 +185,8 @@ int ServeOrThrow(const ServeOptions& o) {
   const std::uint32_t tick_hz = o.tick_hz != 0 ? o.tick_hz : 10000;
   GpioLines lines(o.device, 0, up, down);
   const std::string link = o.link.empty() ? DefaultServeLink() : o.link;
+  // The note first: a client that finds the link finds the note beside it.
+  const ServedDeviceNote note(link, o.device);
   std::unique_ptr<hal::PtyTransport> pty;
   std::string error;
   if (hal::PtyTransport::Open(link, &pty, &error) != hal::IoStatus::kOk) {

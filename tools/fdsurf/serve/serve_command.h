@@ -32,6 +32,12 @@ struct ServeOptions {
 /// $XDG_RUNTIME_DIR/fdsurf-gpio, or /tmp/fdsurf-gpio without it.
 std::string DefaultServeLink();
 
+/// The link (a path) when a running `serve` publishes `device` (a gpio:… spec,
+/// compared as written) at DefaultServeLink(), else "". `serve` writes the
+/// spec it drives beside its link, as LINK.device, while it runs; `stream`
+/// and `machine` given that gpio device go through it then, as serial:LINK.
+std::string ServedGpioLink(const std::string& device);
+
 /// Adds serve's options to `command`.
 void AddServeOptions(CLI::App* command, ServeOptions* options);
 
