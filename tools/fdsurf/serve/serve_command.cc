@@ -145,7 +145,7 @@ std::string DefaultServeLink() {
 }
 
 std::string ServedGpioLink(const std::string& device) {
-  const std::string link = DefaultServeLink();
+  std::string link = DefaultServeLink();
   std::ifstream note(link + ".device");
   std::string served;
   std::getline(note, served);
