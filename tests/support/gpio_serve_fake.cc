@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `fdsurf serve` (tools/fdsurf/serve/, unchanged) on a fake libgpiod 1.6
+// `fdsurf serve`'s server (tools/fdsurf/serve/gpio_server.h, unchanged) on a fake libgpiod 1.6
 // (hal/test/fake_gpiod.cc, linked with --wrap) and a simulated carriage:
 // the server's real pty, real time and real protocol, with GPIO lines that
 // any machine has. Used by tests/cli/gpio_serve_cli_test.cc.
@@ -33,7 +33,7 @@
 
 #include "../../hal/test/fake_gpiod.h"
 #include "../../tools/fdsurf/runners/runner.h"
-#include "../../tools/fdsurf/serve/serve_command.h"
+#include "../../tools/fdsurf/serve/gpio_server.h"
 #include "fdsurf/host/errors.h"
 
 namespace {
@@ -148,7 +148,7 @@ int main(int argc, char** argv) {
   fdsurf::hal::testing::g_fake_gpio = &fake;
   int code = 0;
   try {
-    code = fdsurf::host::RunServe(serve);
+    code = fdsurf::host::ServeGpio(serve);
   } catch (const fdsurf::host::InputError& e) {
     std::fprintf(stderr, "fdsurf: error: %s\n", e.what());
     code = 2;

@@ -18,7 +18,7 @@
 #include "runners/machine_schedule.h"
 #include "runners/runner.h"
 #include "runners/serial_session.h"
-#include "serve/serve_command.h"
+#include "serve/gpio_server.h"
 
 namespace fdsurf::host {
 namespace {

@@ -4,6 +4,14 @@
 // "GPIO on arm64 under QEMU").
 //
 //   fdsurf-gpio-stream JOB --device gpio:CHIP:LINES [--tick-hz N] [--quiet]
+//   fdsurf-gpio-stream serve --device gpio:CHIP:LINES --link PATH [--tick-hz N]
+//   fdsurf-gpio-stream JOB --serial PATH
+//
+// The second form is `fdsurf serve` (tools/fdsurf/serve/gpio_server.cc,
+// ServeGpio, unchanged): the Device on the lines, served on a pty at PATH
+// until SIGTERM. The third streams JOB to such a server as a client on the
+// serial port PATH (termios, raw), the host end of the link (HostLink) as
+// `fdsurf stream --device serial:PATH` drives it.
 //
 // JOB is the job's commands as wire frames, one after the other, as
 // fdsurf_kernel_gpio_job writes them (its first command is the CONFIG). The
@@ -17,16 +25,26 @@
 // option, --device), 3 the device failed (a GPIO line busy, missing, not
 // permitted...), 130 interrupted. Errors are one line on stderr,
 // "fdsurf: error: ...".
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
 
 #include "../../../tools/fdsurf/runners/runner.h"
+#include "../../../tools/fdsurf/serve/gpio_server.h"
 #include "../../../tools/fdsurf/stream_command.h"
+#include "fdsurf/hal/monotonic_clock.h"
 #include "fdsurf/host/errors.h"
+#include "fdsurf/host/link.h"
 #include "fdsurf/protocol/codec.h"
 #include "fdsurf/protocol/frame.h"
 
@@ -46,6 +64,9 @@ namespace {
 struct Options {
   std::string job;
   StreamOptions stream;
+  bool serve = false;  // the first argument was `serve`
+  std::string link;    // serve's --link
+  std::string serial;  // --serial PATH: stream to a server there
 };
 
 Options ParseArguments(int argc, char** argv) {
@@ -55,7 +76,13 @@ Options ParseArguments(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool has_value = i + 1 < argc;
-    if (arg == "--device" && has_value) {
+    if (i == 1 && arg == "serve") {
+      o.serve = true;
+    } else if (arg == "--link" && has_value) {
+      o.link = argv[++i];
+    } else if (arg == "--serial" && has_value) {
+      o.serial = argv[++i];
+    } else if (arg == "--device" && has_value) {
       o.stream.device = argv[++i];
     } else if (arg == "--tick-hz" && has_value) {
       char* end = nullptr;
@@ -74,8 +101,13 @@ Options ParseArguments(int argc, char** argv) {
                        "[--tick-hz N] [--quiet]");
     }
   }
-  if (o.job.empty() || o.stream.device.empty()) {
-    throw InputError("usage: fdsurf-gpio-stream JOB --device gpio:CHIP:LINES [--tick-hz N]");
+  const bool ok = o.serve ? o.job.empty() && !o.link.empty() && !o.stream.device.empty()
+                          : !o.job.empty() && o.stream.device.empty() != o.serial.empty();
+  if (!ok) {
+    throw InputError(
+        "usage: fdsurf-gpio-stream JOB --device gpio:CHIP:LINES [--tick-hz N], "
+        "fdsurf-gpio-stream serve --device gpio:CHIP:LINES --link PATH [--tick-hz N], or "
+        "fdsurf-gpio-stream JOB --serial PATH");
   }
   o.stream.file = o.job;
   return o;
@@ -119,6 +151,54 @@ StreamJob ReadJob(const std::string& path) {
   return job;
 }
 
+// The serial port at `path`, raw (8 bits, no echo, no translation) and
+// non-blocking; InputError naming it when it cannot be opened.
+int OpenSerial(const std::string& path) {
+  const int fd = open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  termios tio{};
+  if (fd < 0 || tcgetattr(fd, &tio) != 0) {
+    throw InputError("--serial " + path + ": " + std::strerror(errno));
+  }
+  cfmakeraw(&tio);
+  tcsetattr(fd, TCSANOW, &tio);
+  return fd;
+}
+
+// The job through HostLink on the serial port, until every command was
+// executed and the device is idle (0), the link failed (3) or 60 s passed.
+int StreamToServer(const Options& o, const StreamJob& job) {
+  const int fd = OpenSerial(o.serial);
+  HostLink link(LinkOptions());
+  Enqueue(job, &link);
+  hal::MonotonicClock clock;
+  const std::uint64_t deadline = clock.NowMicros() + 60'000'000;
+  std::vector<std::uint8_t> out;
+  std::uint8_t in[256];
+  while (!link.Finished() && !link.Failed() && clock.NowMicros() < deadline) {
+    out.clear();
+    link.Poll(clock.NowMicros(), &out);
+    for (std::size_t sent = 0; sent < out.size();) {
+      const ssize_t n = write(fd, out.data() + sent, out.size() - sent);
+      if (n > 0) sent += static_cast<std::size_t>(n);
+      if (n < 0 && errno != EAGAIN && errno != EINTR) {
+        throw DeviceError("--serial " + o.serial + ": write: " + std::strerror(errno));
+      }
+    }
+    pollfd p{fd, POLLIN, 0};
+    (void)poll(&p, 1, 2);
+    const ssize_t n = read(fd, in, sizeof in);
+    if (n > 0) link.OnBytes(in, static_cast<std::size_t>(n), clock.NowMicros());
+  }
+  close(fd);
+  if (link.Failed()) throw DeviceError("serial " + o.serial + ": " + link.error());
+  if (!link.Finished()) throw DeviceError("serial " + o.serial + ": the job took over 60 s");
+  if (!o.stream.quiet) {
+    std::fprintf(stderr, "%s: %zu commands executed by the server at %s\n", o.job.c_str(),
+                 job.commands.size(), o.serial.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 }  // namespace fdsurf::host
 
@@ -126,7 +206,16 @@ int main(int argc, char** argv) {
   using namespace fdsurf::host;
   try {
     Options o = ParseArguments(argc, argv);
+    if (o.serve) {
+      ServeOptions serve;
+      serve.device = o.stream.device;
+      serve.link = o.link;
+      serve.tick_hz = o.stream.tick_hz;
+      serve.quiet = o.stream.quiet;
+      return ServeGpio(serve);
+    }
     const StreamJob job = ReadJob(o.job);
+    if (!o.serial.empty()) return StreamToServer(o, job);
     o.stream.dims = job.config.axes;
     return RunGpio(o.stream, job);
   } catch (const DeviceError& e) {

@@ -5,7 +5,7 @@ tiny initramfs (busybox-static, fdsurf-gpio-stream, a job, an init script) and
 checks what the real kernel's GPIO character device did (docs/testing.md,
 "GPIO on arm64 under QEMU").
 
-  run_guest.py --scenario stream|errors --cache DIR --streamer BIN --out DIR
+  run_guest.py --scenario stream|serve|errors --cache DIR --streamer BIN --out DIR
                [--job JOB --reference REF --checker CHECK] [--timeout S]
 
 stream: the guest streams JOB on the PL061's lines; every line change is
@@ -13,6 +13,12 @@ recorded outside the guest by QEMU's trace events pl061_update and
 pl061_set_output, turned into the waveform format (sim/include/fdsurf/sim/
 waveform.h) and compared by fdsurf_waveform_check with REF, the simulated
 plotter's waveform of the same job.
+
+serve: the same job through `fdsurf serve` on those lines (the second form
+of fdsurf-gpio-stream) and a client streaming it through the server's pty
+(the third form); the same waveform check, and the server, stopped by
+SIGTERM, must say it left the device at rest with the pen lifted and the
+drivers disabled, exit 0 and take its link with it.
 
 errors: a line held by another process, a chip and a line that do not exist,
 a path that is not a GPIO chip, permission denied (a non-root user after
@@ -81,6 +87,25 @@ echo FDSURF-DONE
 poweroff -f
 """
 
+INIT_SERVE = r"""
+# `fdsurf serve` on the lines, a client streaming the job through its pty,
+# then SIGTERM: the server stops the device, lifts the pen, disables the
+# drivers and exits 0. Ptys need devpts, as on any full system.
+mkdir -p /dev/pts
+mount -t devpts devpts /dev/pts
+/bin/fdsurf-gpio-stream serve --device {device} --link /tmp/fdsurf-gpio --tick-hz {tick_hz} 2>/tmp/serve &
+server=$!
+for i in $(seq 100); do [ -e /tmp/fdsurf-gpio ] && break; sleep 0.1; done
+run client /bin/fdsurf-gpio-stream /job --serial /tmp/fdsurf-gpio
+kill -TERM $server
+wait $server; rc=$?
+sed "s/^/FDSURF-STDERR serve: /" /tmp/serve
+result serve $rc
+[ -e /tmp/fdsurf-gpio ] && echo "FDSURF-STDERR serve: the link outlived the server"
+echo FDSURF-DONE
+poweroff -f
+"""
+
 INIT_ERRORS = r"""
 # A line held by another process: a second fdsurf-gpio-stream on the same
 # lines while the first streams (it requests them all before its first tick).
@@ -126,7 +151,7 @@ def build_initramfs(args, init_text, path):
     files += [("bin/busybox", x, read(os.path.join(args.cache, "busybox"))),
               ("gpio_keys.ko", r, read(os.path.join(args.cache, "gpio_keys.ko")))]
     for tool in ("sh", "mount", "sed", "ls", "sleep", "chmod", "su", "poweroff", "cat", "insmod",
-                 "grep", "seq"):
+                 "grep", "seq", "kill", "mkdir"):
         files.append(("bin/" + tool, stat.S_IFLNK | 0o777, b"busybox"))
     files += [("bin/fdsurf-gpio-stream", x, read(args.streamer)),
               ("job", r, read(args.job)),
@@ -255,13 +280,8 @@ def waveform_from_trace(events, path):
     return len(transitions)
 
 
-def check_stream(args, text, trace):
-    found, stderr = results(text)
-    for line in stderr.get("stream", []):
-        print("guest: " + line)
-    if found.get("stream") != 0:
-        print("FAIL: fdsurf-gpio-stream exited %s in the guest" % found.get("stream"))
-        return 1
+def check_waveform(args, trace, messages):
+    """The trace's waveform against the simulated plotter's (0 when the same)."""
     recorded = os.path.join(args.out, "recorded.wave")
     changes = waveform_from_trace(trace_events(trace), recorded)
     print("trace: %d line changes while the lines were outputs -> %s" % (changes, recorded))
@@ -274,13 +294,44 @@ def check_stream(args, text, trace):
     # apart; a host that stalled the guest longer than that between the two
     # ioctls of one tick splits a diagonal step (docs/testing.md).
     window_ms = 500.0 / args.tick_hz
-    for line in stderr.get("stream", []):
+    for line in messages:
         m = re.search(r"late \(longest ([0-9.]+) ms\)", line)
         if m and float(m.group(1)) > window_ms:
             print("note: the guest's tick loop stalled %s ms, more than the checker's %.1f ms "
                   "grouping window: if the first difference is a diagonal step split in two, "
                   "the host was too loaded for this check" % (m.group(1), window_ms))
     return 1
+
+
+def check_stream(args, text, trace):
+    found, stderr = results(text)
+    for line in stderr.get("stream", []):
+        print("guest: " + line)
+    if found.get("stream") != 0:
+        print("FAIL: fdsurf-gpio-stream exited %s in the guest" % found.get("stream"))
+        return 1
+    return check_waveform(args, trace, stderr.get("stream", []))
+
+
+def check_serve(args, text, trace):
+    found, stderr = results(text)
+    for name in ("client", "serve"):
+        for line in stderr.get(name, []):
+            print("guest %s: %s" % (name, line))
+    said = " / ".join(stderr.get("serve", []))
+    failures = []
+    if found.get("client") != 0:
+        failures.append("the client exited %s" % found.get("client"))
+    if found.get("serve") != 0:
+        failures.append("the server exited %s" % found.get("serve"))
+    for expected in ("at rest, pen lifted, drivers disabled", "1 sessions"):
+        if expected not in said:
+            failures.append("the server did not say '%s'" % expected)
+    if "outlived" in said:
+        failures.append("the link outlived the server")
+    for failure in failures:
+        print("FAIL: " + failure)
+    return check_waveform(args, trace, stderr.get("serve", [])) or (1 if failures else 0)
 
 
 def check_errors(text):
@@ -299,7 +350,7 @@ def check_errors(text):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--scenario", choices=["stream", "errors"], required=True)
+    parser.add_argument("--scenario", choices=["stream", "serve", "errors"], required=True)
     parser.add_argument("--cache", required=True, help="vmlinuz and busybox (fetch_guest.sh)")
     parser.add_argument("--streamer", required=True, help="the arm64 fdsurf-gpio-stream")
     parser.add_argument("--job", required=True, help="the job (fdsurf_kernel_gpio_job)")
@@ -311,7 +362,7 @@ def main():
     parser.add_argument("--timeout", type=float, default=120)
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    template = INIT_STREAM if args.scenario == "stream" else INIT_ERRORS
+    template = {"stream": INIT_STREAM, "serve": INIT_SERVE, "errors": INIT_ERRORS}[args.scenario]
     init = INIT_COMMON + template.format(device=DEVICE, tick_hz=args.tick_hz,
                                          power_key=POWER_KEY_LINE)
     initrd = os.path.join(args.out, "initrd.cpio")
@@ -322,6 +373,8 @@ def main():
     text = boot(args, initrd, trace)
     if args.scenario == "stream":
         return check_stream(args, text, trace)
+    if args.scenario == "serve":
+        return check_serve(args, text, trace)
     return check_errors(text)
 
 

@@ -18,7 +18,7 @@
 #include "../runners/runner.h"
 #include "../runners/serial_session.h"
 #include "../runners/usb_session.h"
-#include "../serve/serve_command.h"
+#include "../serve/gpio_server.h"
 #include "../stream_command.h"
 #include "fdsurf/hal/serial_transport.h"
 #include "fdsurf/host/errors.h"
