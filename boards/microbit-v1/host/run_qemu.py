@@ -5,6 +5,7 @@ emulated board (the harness interface of docs/boards.md and the common brief):
 
   run_qemu.py --elf FILE --uart-socket PATH --waveform OUT [--time-limit-s N]
               [--measures OUT.tsv] [--plugin SO] [--baud B] [--qemu EXE]
+              [--endstop-start X,Y]
 
 - LISTENS on the Unix stream socket PATH (one client at a time; the next one
   is accepted when it leaves; the board keeps running). The client's bytes go
@@ -38,6 +39,19 @@ host's wall clock, if at all). The TCG plugin microbit_pins_plugin.c writes
 each change is stamped with the exact instruction count of the store that
 caused it; the plugin also publishes the count in a shared file, the clock
 that paces the UART bytes.
+
+Endstops (--endstop-start X,Y). A simulated carriage starts X, Y steps above
+the min switches (pins.h: edge P2 and P12, pulled up, a closed switch reads
+LOW) and counts the STEP rising edges as the waveform is read, each towards
+negative while DIR is high. When an axis reaches or passes 0 its switch
+closes: the harness drives that GPIO input LOW through QEMU's qtest protocol
+(`-qtest unix:...`, `set_irq_in /machine/nrf51 unnamed-gpio-in PIN 0`; the
+CPU keeps running under TCG), and HIGH again when the carriage leaves. The
+harness reads the log every 2 ms of wall time then, and the guest runs at
+about wall-clock speed (align=on), so a switch closes up to a few ms of
+emulated time late: at a homing rate of 200 steps/s a step or two past it
+(simavr's harness, in the same process as the CPU, is exact). At exit it
+prints "carriage X n Y m" (steps above each switch) on stderr.
 """
 import argparse
 import collections
@@ -82,6 +96,7 @@ TIMER_HZ = 16_000_000
 PIN_SIGNALS = {23: ("X_STEP",), 22: ("X_DIR",), 21: ("Y_STEP",), 16: ("Y_DIR",),
                18: ("X_EN", "Y_EN")}
 PEN_PIN, SERVO_PIN = 3, 2
+MIN_SWITCH_PINS = (1, 20)  # X, Y min endstops (src/pins.h: kXMin, kYMin)
 WAVEFORM_HEADER = ("# fdsurf-waveform 1\n# board microbit-v1\n# dir_negative_level 1\n"
                    "# enable_active_level 0\n")
 TRACE_RE = re.compile(r"nrf51_gpio_update_output_irq line (\d+) value (-?\d+)")
@@ -108,6 +123,7 @@ class Waveform:
         self.partial = ""
         self.end_count = None
         self.changes = collections.Counter()
+        self.on_change = None  # called (signal, level) for each change written
 
     def feed(self, text):
         lines = (self.partial + text).split("\n")
@@ -129,6 +145,8 @@ class Waveform:
                     self.levels[signal_name] = level
                     self.changes[signal_name] += 1
                     self.out.write(f"{count * NS_PER_INSN} {signal_name} {level}\n")
+                    if self.on_change is not None:
+                        self.on_change(signal_name, level)
         self.pending = []
 
     def close(self):
@@ -138,6 +156,38 @@ class Waveform:
     def discard(self):
         self.out.close()
         os.unlink(self.path + ".tmp")
+
+
+class Carriage:
+    """The simulated X/Y carriage above its min switches (--endstop-start),
+    fed the waveform's changes; drive(pin, level) sets a switch's input."""
+
+    def __init__(self, start, drive):
+        self.position = list(start)
+        self.dir_level = [0, 0]
+        self.step_level = [0, 0]
+        self.drive = drive
+        self.closed = [None, None]
+        self.update()
+
+    def change(self, signal_name, level):
+        axis = "XY".find(signal_name[0])
+        if axis < 0:
+            return
+        if signal_name.endswith("_DIR"):
+            self.dir_level[axis] = level
+        elif signal_name.endswith("_STEP"):
+            if level == 1 and self.step_level[axis] == 0:
+                self.position[axis] += -1 if self.dir_level[axis] == 1 else 1
+                self.update()
+            self.step_level[axis] = level
+
+    def update(self):
+        for axis in (0, 1):
+            closed = self.position[axis] <= 0
+            if closed != self.closed[axis]:
+                self.closed[axis] = closed
+                self.drive(MIN_SWITCH_PINS[axis], 0 if closed else 1)
 
 
 class UartPacer:
@@ -252,7 +302,9 @@ def qemu_command(args, work, plugin):
             "-monitor", f"unix:{work}/monitor.sock,server=on,wait=off",
             "-plugin", f"{plugin},clock={work}/clock.bin",
             "-d", "plugin", "-D", f"{work}/qemu.log",
-            "-trace", "enable=nrf51_gpio_update_output_irq"]
+            "-trace", "enable=nrf51_gpio_update_output_irq"] + (
+                ["-qtest", f"unix:{work}/qtest.sock,server=on,wait=off"]
+                if args.endstop_start is not None else [])
 
 
 def connect_unix(path, deadline, process=None):
@@ -305,6 +357,8 @@ class Harness:
         self.clients = 0
         self.qemu = None
         self.listener = None
+        self.qtest = None
+        self.carriage = None
 
     def start(self):
         plugin = self.args.plugin or (DEFAULT_PLUGIN if os.path.exists(DEFAULT_PLUGIN)
@@ -323,6 +377,11 @@ class Harness:
         with open(f"{self.work}/clock.bin", "r+b") as f:
             self.clock = mmap.mmap(f.fileno(), 4096)
         self.log = open(f"{self.work}/qemu.log", "r", encoding="ascii", errors="replace")
+        if self.args.endstop_start is not None:
+            self.qtest = connect_unix(f"{self.work}/qtest.sock", deadline, self.qemu)
+            self.qtest.settimeout(5)
+            self.carriage = Carriage(self.args.endstop_start, self.drive_input)
+            self.waveform.on_change = self.carriage.change
         if os.path.exists(self.args.uart_socket):
             os.unlink(self.args.uart_socket)
         self.listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -335,6 +394,18 @@ class Harness:
 
     def now(self):
         return struct.unpack_from("<Q", self.clock, 0)[0]
+
+    def drive_input(self, pin, level):
+        """Drives the GPIO input `pin` to `level` (qtest set_irq_in)."""
+        self.qtest.sendall(b"set_irq_in /machine/nrf51 unnamed-gpio-in %d %d\n" % (pin, level))
+        reply = b""
+        while not reply.endswith(b"\n"):
+            chunk = self.qtest.recv(256)
+            if not chunk:
+                raise SystemExit("run_qemu.py: QEMU closed the qtest socket")
+            reply += chunk
+        if not reply.startswith(b"OK"):
+            raise SystemExit(f"run_qemu.py: qtest refused set_irq_in: {reply!r}")
 
     def drop_client(self):
         self.selector.unregister(self.client)
@@ -373,7 +444,7 @@ class Harness:
             if self.qemu.poll() is not None:
                 raise SystemExit(f"run_qemu.py: QEMU exited early ({self.qemu.returncode}); "
                                  f"see {self.work}/qemu.stderr")
-            timeout = 0.0005 if self.pacer.pending else 0.02
+            timeout = 0.0005 if self.pacer.pending else 0.002 if self.carriage else 0.02
             for key, _ in self.selector.select(timeout):
                 self.handle(key.data)
             due = self.pacer.due(self.now())
@@ -405,6 +476,8 @@ class Harness:
             ram = open(f"{self.work}/ram.bin", "rb").read()
         self.waveform.feed(self.log.read() + "\n")
         self.waveform.close()
+        if self.carriage is not None:
+            print("carriage X %d Y %d" % tuple(self.carriage.position), file=sys.stderr)
         if self.args.measures:
             write_measures(self.args, self, ram)
         if self.client is not None:
@@ -499,7 +572,23 @@ def parse_args(argv):
     p.add_argument("--baud", type=int, default=115200)
     p.add_argument("--qemu", default="qemu-system-arm")
     p.add_argument("--keep", action="store_true", help="keep the work directory (QEMU's log)")
+    p.add_argument("--endstop-start", help="X,Y: a carriage that many steps above the min "
+                                           "switches, which it drives (see above)")
+    # "--endstop-start -40,10" (as the simavr harness takes it): argparse
+    # would read the negative value as an option.
+    argv = list(argv)
+    for i, arg in enumerate(argv[:-1]):
+        if arg == "--endstop-start":
+            argv[i:i + 2] = ["--endstop-start=" + argv[i + 1]]
+            break
     args = p.parse_args(argv)
+    if args.endstop_start is not None:
+        try:
+            args.endstop_start = [int(v) for v in args.endstop_start.split(",")]
+        except ValueError:
+            args.endstop_start = []
+        if len(args.endstop_start) != 2:
+            p.error("--endstop-start: X,Y, whole numbers of steps")
     if not os.path.isfile(args.elf):
         p.error(f"--elf: {args.elf}: no such file")
     if args.time_limit_s <= 0:

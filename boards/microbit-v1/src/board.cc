@@ -4,13 +4,15 @@
 // pins, 115200 8N1, receive interrupt into a ring, polled send), the step
 // tick from TIMER0's compare interrupt, step/dir/enable on edge-connector
 // pins (pins.h), the pen as a hobby servo's pulses from TIMER1 (servo_pwm.h)
-// or, built with FDSURF_MICROBIT_SERVO=0, as a line. The main loop only
+// or, built with FDSURF_MICROBIT_SERVO=0, as a line, and X/Y min endstops on
+// two more pins (endstop_pins.h). The main loop only
 // services the link and fills the lookahead buffer; Device::Tick() runs in
 // the timer interrupt.
 #include <stddef.h>
 #include <stdint.h>
 
 #include "board_stats.h"
+#include "endstop_pins.h"
 #include "fdsurf/board/byte_ring.h"
 #include "fdsurf/board/uart_transport.h"
 #include "fdsurf/device/device.h"
@@ -219,6 +221,7 @@ using BoardDevice = device::Device<2, 8, kLookahead, TickLock>;
 RxRing g_rx;
 BoardDevice g_device(kTickHz);
 PinOutputs g_outputs;
+PinEndstops g_endstops;
 TimerPwm g_servo_pwm(pins::kServo);
 hal::ServoPen g_servo_pen(g_servo_pwm, kServoUpUs, kServoDownUs);
 uint32_t g_next_compare;
@@ -389,6 +392,8 @@ void fdsurf_board_main() {
   fdsurf_board_stats.magic = kBoardStatsMagic;
   fdsurf_board_stats.tick_hz = kTickHz;
   SetUpPins();
+  SetUpEndstopPins();
+  g_device.set_endstops(&g_endstops);
   SetUpClock();
   SetUpUart();
   UartTransport<RxRing, Uart> link(g_rx);

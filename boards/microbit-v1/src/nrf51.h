@@ -81,6 +81,7 @@ constexpr uint32_t kGpio = 0x50000000u;
 constexpr uint32_t kGpioOut = kGpio + 0x504u;
 constexpr uint32_t kGpioOutSet = kGpio + 0x508u;
 constexpr uint32_t kGpioOutClr = kGpio + 0x50Cu;
+constexpr uint32_t kGpioIn = kGpio + 0x510u;
 constexpr uint32_t kGpioDirSet = kGpio + 0x518u;
 inline constexpr uint32_t GpioPinCnf(uint32_t pin) { return kGpio + 0x700u + 4u * pin; }
 // PIN_CNF: DIR output, input buffer disconnected, no pull, drive S0S1.

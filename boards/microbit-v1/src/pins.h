@@ -19,6 +19,10 @@ constexpr uint32_t kYDir = 16;    // edge P16
 constexpr uint32_t kEnable = 18;  // edge P8, shared by both drivers, active low
 constexpr uint32_t kPen = 3;      // edge P0 (the big ring), 1 = pen down (pen line build)
 constexpr uint32_t kServo = 2;    // edge P1 (big ring), the pen servo's pulses (servo build)
+// The X and Y min endstops: normally-open switches to GND, internal pull-ups
+// on (a closed switch reads 0), as Grbl wires its limit pins.
+constexpr uint32_t kXMin = 1;   // edge P2 (the big ring)
+constexpr uint32_t kYMin = 20;  // edge P12
 
 // The UART to the interface chip (KL26Z), which the USB cable presents as
 // a CDC-ACM port (/dev/ttyACM0): the target's TX and RX.
@@ -28,6 +32,7 @@ constexpr uint32_t kUartRx = 25;
 constexpr uint32_t Bit(uint32_t pin) { return 1u << pin; }
 constexpr uint32_t kStepBits[2] = {Bit(kXStep), Bit(kYStep)};
 constexpr uint32_t kDirBits[2] = {Bit(kXDir), Bit(kYDir)};
+constexpr uint32_t kMinBits[2] = {Bit(kXMin), Bit(kYMin)};
 constexpr uint32_t kOutputBits =
     Bit(kXStep) | Bit(kXDir) | Bit(kYStep) | Bit(kYDir) | Bit(kEnable) | Bit(kPen) | Bit(kServo);
 
