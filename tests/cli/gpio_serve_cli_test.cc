@@ -27,30 +27,13 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using fdsurf::test_support::RunResult;
+using fdsurf::test_support::SecondsSince;
 using fdsurf::test_support::Slurp;
+using fdsurf::test_support::WaitForExit;
 
 // The lines gpio_serve_fake.cc serves, as its --device.
 const std::string kLines = "gpio:gpiochip0:0,1,2,3,4,5:xmin=!6,ymin=!7";
 const std::string kLinesArg = "'" + kLines + "'";  // for the shell
-
-double SecondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-// Waits for `pid` at most `timeout_s`, then kills it; its exit code, or -1.
-int WaitFor(pid_t pid, double timeout_s) {
-  const auto start = Clock::now();
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (SecondsSince(start) > timeout_s) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      return -1;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 // A zigzag of 30 pen-down lines of 10 mm or so (more commands than the
 // device queues), as tests/cli/serial_cli_test.cc's.
@@ -101,7 +84,7 @@ class GpioServe : public fdsurf::test_support::ToolTest {
   std::map<std::string, std::string> StopServer(int signal = SIGTERM) {
     if (signal != 0) kill(server_, signal);
     std::map<std::string, std::string> report;
-    report["exit_code"] = std::to_string(WaitFor(server_, 20));
+    report["exit_code"] = std::to_string(WaitForExit(server_, 20));
     server_ = -1;
     std::istringstream lines(Slurp(dir_ / "report"));
     for (std::string key, value; lines >> key >> value;) report[key] = value;
@@ -223,7 +206,7 @@ TEST_F(GpioServe, StoppingTheServerMidJobLeavesThePenUpAndTheDriversOff) {
   EXPECT_EQ(report["enable_level"], "1");
   EXPECT_NE(report["steps_x"], "0");
   EXPECT_FALSE(fs::exists(link_)) << "the link outlived the server";
-  EXPECT_EQ(WaitFor(pid, 20), 3) << Slurp(dir_ / "bg.err");
+  EXPECT_EQ(WaitForExit(pid, 20), 3) << Slurp(dir_ / "bg.err");
   EXPECT_LT(SecondsSince(start), 20);
 }
 
@@ -239,7 +222,7 @@ TEST_F(GpioServe, AFailingOutputIsExit3NamingTheLineWithTheDriversOff) {
   EXPECT_NE(ServerErr().find("(pen NOT lifted, drivers disabled)"), std::string::npos)
       << ServerErr();
   EXPECT_EQ(report["enable_level"], "1");
-  EXPECT_NE(WaitFor(pid, 20), 0);
+  EXPECT_NE(WaitForExit(pid, 20), 0);
 }
 
 TEST_F(GpioServe, BadDevicesAndLinksAreRefusedBeforeAnythingOpens) {

@@ -25,38 +25,17 @@
 #include <thread>
 #include <vector>
 
+#include "tool_run.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+using fdsurf::test_support::SecondsSince;
+using fdsurf::test_support::Slurp;
+using fdsurf::test_support::WaitForExit;
 
 const std::string kJob = std::string("'") + FDSURF_EXAMPLES_DIR + "/bezier-bump.json' --lines 3";
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-double SecondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-// Waits for `pid` at most `timeout_s`, then kills it; its exit code, or -1.
-int WaitFor(pid_t pid, double timeout_s) {
-  const auto start = Clock::now();
-  int status = 0;
-  while (waitpid(pid, &status, WNOHANG) == 0) {
-    if (SecondsSince(start) > timeout_s) {
-      kill(pid, SIGKILL);
-      waitpid(pid, &status, 0);
-      return -1;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 struct Result {
   int exit_code;
@@ -104,7 +83,7 @@ class SerialCli : public ::testing::Test {
     std::map<std::string, std::string> report;
     if (device_ <= 0) return report;
     kill(device_, SIGTERM);
-    EXPECT_EQ(WaitFor(device_, 10), 0);
+    EXPECT_EQ(WaitForExit(device_, 10), 0);
     device_ = -1;
     std::istringstream lines(Slurp(dir_ / "report"));
     for (std::string key, value; lines >> key >> value;) report[key] = value;
@@ -144,7 +123,7 @@ class SerialCli : public ::testing::Test {
   }
 
   Result Finish(pid_t pid, Clock::time_point start, double timeout_s = 30) {
-    const int code = WaitFor(pid, timeout_s);
+    const int code = WaitForExit(pid, timeout_s);
     return {code, Slurp(dir_ / "stdout"), Slurp(dir_ / "stderr"), SecondsSince(start)};
   }
 
