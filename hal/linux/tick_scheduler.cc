@@ -18,5 +18,12 @@ uint64_t TickScheduler::WaitForNextTick() {
   return now;
 }
 
+void TickScheduler::EndTick() {
+  const uint64_t now = clock_.NowMicros();
+  if (now - last_tick_us_ <= period_us_ / 2) return;
+  ++stalled_ticks_;
+  last_tick_us_ = now;
+}
+
 }  // namespace hal
 }  // namespace fdsurf

@@ -24,6 +24,9 @@ class FakeClock final : public Clock {
   FakeClock(std::uint64_t stall_at, std::uint64_t stall_us, std::uint64_t jitter_us = 0)
       : stall_at_(stall_at), stall_us_(stall_us), jitter_us_(jitter_us) {}
   FDSURF_NODISCARD std::uint64_t sleeps() const { return sleeps_; }
+  /// Time passing while the tick works (a stall between the wake-up and
+  /// the writes, when large).
+  void Advance(std::uint64_t us) { now_ += us; }
 
  private:
   std::uint64_t DoNowMicros() override { return now_; }
@@ -120,6 +123,34 @@ TEST(TickScheduler, TheFirstTickIsDueAtOnceAndEachSleepsOnce) {
   EXPECT_EQ(clock.sleeps(), 2u);
   EXPECT_EQ(scheduler.late_ticks(), 0u);
   EXPECT_EQ(scheduler.period_us(), kPeriod);
+}
+
+// The time of each tick's writes, made `work_us` after the wake-up, and
+// `stall_us` after it at tick `stall_at`; EndTick() after them when
+// `end_tick`.
+std::vector<std::uint64_t> WriteTimes(bool end_tick, int stall_at, std::uint64_t stall_us,
+                                      std::uint64_t work_us) {
+  FakeClock clock(UINT64_MAX, 0);
+  TickScheduler scheduler(clock, kPeriod);
+  std::vector<std::uint64_t> writes;
+  for (int i = 0; i < 400; ++i) {
+    scheduler.WaitForNextTick();
+    clock.Advance(i == stall_at ? stall_us : work_us);
+    writes.push_back(clock.NowMicros());
+    if (end_tick) scheduler.EndTick();
+  }
+  EXPECT_EQ(scheduler.stalled_ticks(), end_tick && stall_us > kPeriod / 2 ? 1u : 0u);
+  return writes;
+}
+
+TEST(TickScheduler, AStallInsideATickDelaysTheNextTickPastItsWrites) {
+  // 1.5 periods between a wake-up and its writes: without EndTick() the
+  // next tick, already due, writes its work's 5 µs after them.
+  EXPECT_EQ(ShortestInterval(WriteTimes(false, 100, 3 * kPeriod / 2, 5)), 5u);
+  EXPECT_EQ(ShortestInterval(WriteTimes(true, 100, 3 * kPeriod / 2, 5)), kPeriod);
+  // Ordinary work moves nothing: 400 ticks in 399 periods, as without it.
+  const std::vector<std::uint64_t> plain = WriteTimes(true, -1, 0, kPeriod / 2);
+  EXPECT_EQ(plain.back() - plain.front(), 399 * kPeriod);
 }
 
 }  // namespace

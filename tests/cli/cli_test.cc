@@ -159,7 +159,7 @@ TEST_F(Cli, BadInputIsRefusedWithNothingOnStdout) {
   ExpectRefused("sample '" + kTeapot + "' --grid 4 --frobnicate", "frobnicate");
   ExpectRefused("bake '" + kTeapot + "'",
                 "unknown command 'bake' (expected sample, check, plot, render, stream, joins, "
-                "ports or machine)");
+                "ports, machine or serve)");
   ExpectRefused("check '" + kTeapot + "' --grid 4 --quantum 0.000000001",
                 "teapot.bpt:2 (patch 0): geometry [0][0].z = 2.4 is out of range");
 

@@ -328,14 +328,15 @@ TEST_F(MachineCli, GpioEndstopsAreCheckedBeforeAnyLineIsOpened) {
   EXPECT_NE(good.err.find("fdsurf-no-chip"), std::string::npos) << good.err;
 }
 
-// Machine commands on a gpio device are refused before any line is opened
-// (nothing would hold the position between invocations), and say why; a
-// usb device that is not there is a device error naming it.
+// Machine commands on a gpio device with no `fdsurf serve` holding it are
+// refused before any line is opened (nothing would hold the position
+// between invocations) and say what to start; a usb device that is not
+// there is a device error naming it.
 TEST_F(MachineCli, MachineCommandsRefuseGpioAndNameAMissingUsbDevice) {
   const RunResult gpio = Run("machine where --travel 100x80 --device gpio:gpiochip0:1,2,3,4,5,6");
   EXPECT_EQ(gpio.exit_code, 2);
-  EXPECT_NE(gpio.err.find("machine commands do not run on gpio devices yet: the tool is the "
-                          "controller there, and nothing holds the position once it exits"),
+  EXPECT_NE(gpio.err.find("nothing holds this machine's position between commands: start "
+                          "`fdsurf serve --device gpio:gpiochip0:1,2,3,4,5,6`"),
             std::string::npos)
       << gpio.err;
   const RunResult usb = Run("machine where --travel 100x80 --device usb:1209:fd5f");

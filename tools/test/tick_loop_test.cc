@@ -59,6 +59,7 @@ class CatchUpScheduler {
     clock_.SleepUntilMicros(next_);
     return clock_.NowMicros();
   }
+  void EndTick() {}  // it had no such step
 
  private:
   hal::Clock& clock_;

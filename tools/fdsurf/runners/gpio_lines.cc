@@ -1,6 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "gpio_lines.h"
 
+#include <sched.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include "fdsurf/hal/monotonic_clock.h"
 #include "fdsurf/host/errors.h"
 #include "runner.h"
@@ -82,6 +87,19 @@ GpioLines::SafeState GpioLines::MakeSafe() {
   state.pen_lifted = pen().SetPen(false) == hal::IoStatus::kOk;
   state.drivers_disabled = outputs_->SetEnabled(false) == hal::IoStatus::kOk;
   return state;
+}
+
+std::string RunInRealTime() {
+  // Above every ordinary process, below the kernel's threaded interrupt
+  // handlers (SCHED_FIFO 50), which the pty and the GPIO ioctls may need.
+  constexpr int kPriority = 40;
+  sched_param param{};
+  param.sched_priority = kPriority;
+  if (sched_setscheduler(0, SCHED_FIFO, &param) == 0) {
+    return "real-time scheduling (SCHED_FIFO " + std::to_string(kPriority) + ")";
+  }
+  return std::string("no real-time scheduling (") + std::strerror(errno) +
+         ": run it as root or give the user an rtprio limit; ticks may come late under load)";
 }
 
 }  // namespace fdsurf::host

@@ -80,4 +80,17 @@ class GpioLines {
   std::unique_ptr<PwmServoPen> servo_;
 };
 
+/// Puts the calling process under SCHED_FIFO (priority 40: above every
+/// ordinary process, below the kernel's threaded interrupt handlers at 50),
+/// as Klipper's Linux MCU process asks for real-time scheduling (its -r).
+/// Another process that preempts the tick loop between a tick's wake-up and
+/// its line writes makes that step late, and the next one, on time, comes
+/// too soon after it: a step 2 ms after the previous one at a 4 ms minimum
+/// was seen on the arm64 guest, one CPU shared with a client. The loop
+/// sleeps between ticks, so it leaves the CPU to others. Needs
+/// CAP_SYS_NICE (root, or an rtprio limit); without it nothing changes.
+/// Returns how the process now runs, for a banner ("real-time scheduling
+/// (SCHED_FIFO 40)", or "no real-time scheduling (WHY: ...)").
+std::string RunInRealTime();
+
 }  // namespace fdsurf::host

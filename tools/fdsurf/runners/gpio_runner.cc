@@ -147,6 +147,7 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
   }
   CheckSpeedAgainstTicks(job, tick_hz, o);
   GpioLines lines(o.device, o.dims, job.config.servo_up_us, job.config.servo_down_us);
+  const std::string scheduling = RunInRealTime();
   const InterruptGuard interrupts;
   GpioRig rig(lines, tick_hz, o.quiet);
   rig.progress.SetSchedule(o.schedule.get());
@@ -161,8 +162,8 @@ int RunGpio(const StreamOptions& o, const StreamJob& job) {
     code = RunLayers(o, job, rig, *device, tick_hz);
   }
   if (code != 0 || o.quiet) return code;
-  std::fprintf(stderr, "%s: %s drawn on %s at %u Hz ticks\n", o.file.c_str(),
-               JobContents(job).c_str(), o.device.c_str(), tick_hz);
+  std::fprintf(stderr, "%s: %s drawn on %s at %u Hz ticks, %s\n", o.file.c_str(),
+               JobContents(job).c_str(), o.device.c_str(), tick_hz, scheduling.c_str());
   const hal::TickScheduler& ticks = rig.ticks;
   if (ticks.late_ticks() != 0) {
     std::fprintf(stderr,

@@ -20,8 +20,8 @@
 namespace fdsurf::host {
 
 /// Runs `device` with `link` while `keep_going()` (asked before every
-/// tick), one Tick per `ticks.WaitForNextTick()` (a hal::TickScheduler;
-/// tests pass other policies). `on_service(now_us)` is called after each
+/// tick), one Tick per `ticks.WaitForNextTick()`, then `ticks.EndTick()`
+/// (a hal::TickScheduler; tests pass other policies). `on_service(now_us)` is called after each
 /// service (for progress). Returns kOk, or the status of the first Tick that
 /// failed (the outputs' LastError() says why).
 template <class Device, class Ticks, class OnService, class KeepGoing>
@@ -45,6 +45,7 @@ hal::IoStatus RunTickLoopWhile(hal::Clock& clock, Ticks& ticks, HostLink& link, 
     ticks.WaitForNextTick();
     const hal::IoStatus status = device.Tick(steppers, pen);
     if (status != hal::IoStatus::kOk) return status;
+    ticks.EndTick();
   }
   return hal::IoStatus::kOk;
 }

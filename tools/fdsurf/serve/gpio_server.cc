@@ -54,6 +54,7 @@ hal::IoStatus Serve(Server& server, Device& device, KeepGoing keep_going) {
     server.ticks.WaitForNextTick();
     const hal::IoStatus status = device.Tick(server.lines.outputs(), server.lines.pen());
     if (status != hal::IoStatus::kOk) return status;
+    server.ticks.EndTick();
   }
   return hal::IoStatus::kOk;
 }
@@ -79,14 +80,22 @@ int StopServing(const ServeOptions& o, Server& server, Device& device) {
   const hal::TickScheduler& ticks = server.ticks;
   std::fprintf(stderr,
                "fdsurf serve: stopped %s: %u sessions, %u commands executed, %s, pen %s, drivers "
-               "%s; %llu of %llu ticks late (longest %.1f ms)\n",
+               "%s; %llu of %llu ticks late (longest %.1f ms), %llu stalled before their "
+               "writes\n",
                o.device.c_str(), device.link_stats().hellos, device.executed(),
                at_rest ? "at rest" : "halted (the position may be lost)",
                safe.pen_lifted ? "lifted" : "NOT lifted",
                safe.drivers_disabled ? "disabled" : "NOT disabled",
                static_cast<unsigned long long>(ticks.late_ticks()),
                static_cast<unsigned long long>(ticks.ticks()),
-               static_cast<double>(ticks.max_lateness_us()) / 1000.0);
+               static_cast<double>(ticks.max_lateness_us()) / 1000.0,
+               static_cast<unsigned long long>(ticks.stalled_ticks()));
+  if (server.port_errors != 0) {
+    std::fprintf(stderr,
+                 "fdsurf serve: %llu times a client did not read its replies in time (the "
+                 "protocol resent what it missed)\n",
+                 static_cast<unsigned long long>(server.port_errors));
+  }
   if (status != hal::IoStatus::kOk) {
     std::fprintf(stderr, "fdsurf: error: serve: %s\n", server.lines.OutputError().c_str());
     return 3;
@@ -173,12 +182,13 @@ int ServeGpio(const ServeOptions& o) {
   }
   const InterruptGuard interrupts;
   Server server(lines, *pty, tick_hz);
+  const std::string scheduling = RunInRealTime();
   if (!o.quiet) {
     std::fprintf(stderr,
-                 "fdsurf serve: %s, %d axes, %u Hz ticks, served at %s (%s): use --device "
+                 "fdsurf serve: %s, %d axes, %u Hz ticks, %s, served at %s (%s): use --device "
                  "serial:%s; Ctrl-C stops\n",
-                 o.device.c_str(), lines.axes(), tick_hz, link.c_str(), pty->slave_name().c_str(),
-                 link.c_str());
+                 o.device.c_str(), lines.axes(), tick_hz, scheduling.c_str(), link.c_str(),
+                 pty->slave_name().c_str(), link.c_str());
   }
   if (lines.axes() == 3) return ServeUntilSignalled<device::Device<3>>(o, server, tick_hz);
   return ServeUntilSignalled<device::Device<2>>(o, server, tick_hz);

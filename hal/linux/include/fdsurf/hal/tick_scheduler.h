@@ -6,12 +6,15 @@
 // process). Catching up on the ticks a stall has missed would fire them back
 // to back and compress the motion beyond the speed limit; instead, the next
 // tick is due one period after the tick that actually happened, so a late tick
-// stretches the motion and never compresses it:
+// stretches the motion and never compresses it. A stall can also come inside
+// a tick, after the wake-up and before the tick's line writes; EndTick()
+// after the writes then moves the next tick a period past them:
 //
 //   hal::TickScheduler ticks(clock, 100);   // 10 kHz
 //   for (;;) {
 //     ticks.WaitForNextTick();
 //     device.Tick(steppers, pen);
+//     ticks.EndTick();
 //   }
 #pragma once
 
@@ -33,6 +36,15 @@ class TickScheduler {
   /// period apart, however late any wake-up was.
   uint64_t WaitForNextTick();
 
+  /// Called when the tick's work (its outputs) is done. If that is more than
+  /// half a period after the tick, the work was stalled (the process was
+  /// preempted, the host stalled a guest) and its writes came late: the next
+  /// tick is then due one period after now, not after the tick, so the next
+  /// writes do not follow these too soon. Counted in stalled_ticks(). A
+  /// tick's ordinary work (well under half a period) changes nothing, so
+  /// the tick rate stays the configured one.
+  void EndTick();
+
   FDSURF_NODISCARD uint64_t period_us() const { return period_us_; }
   /// Ticks so far.
   FDSURF_NODISCARD uint64_t ticks() const { return ticks_; }
@@ -41,6 +53,8 @@ class TickScheduler {
   FDSURF_NODISCARD uint64_t late_ticks() const { return late_ticks_; }
   /// The longest wake-up delay beyond the due time, µs.
   FDSURF_NODISCARD uint64_t max_lateness_us() const { return max_lateness_us_; }
+  /// Ticks whose work EndTick() found stalled past half a period.
+  FDSURF_NODISCARD uint64_t stalled_ticks() const { return stalled_ticks_; }
 
  private:
   Clock& clock_;
@@ -49,6 +63,7 @@ class TickScheduler {
   uint64_t ticks_ = 0;
   uint64_t late_ticks_ = 0;
   uint64_t max_lateness_us_ = 0;
+  uint64_t stalled_ticks_ = 0;
 };
 
 }  // namespace hal
