@@ -334,16 +334,8 @@ int RunStream(const StreamOptions& options) {
   // Messages name standard input "<stdin>", as the reader does.
   StreamOptions o = options;
   if (o.file == "-") o.file = "<stdin>";
-  if (DeviceKindOf(o.device) == DeviceKind::kGpio && !o.dry_run) {
-    // A running `fdsurf serve` holds these lines: through it, as a board.
-    const std::string served = ServedGpioLink(o.device);
-    if (!served.empty()) {
-      if (!o.quiet) {
-        std::fprintf(stderr, "fdsurf: %s is served at %s\n", o.device.c_str(), served.c_str());
-      }
-      o.device = "serial:" + served;
-    }
-  }
+  // A running `fdsurf serve` holding these lines: through it, as a board.
+  if (!o.dry_run) o.device = DeviceThroughServer(o.device, o.quiet);
   const bool sim = DeviceKindOf(o.device) == DeviceKind::kSim;
   if (DeviceKindOf(o.device) == DeviceKind::kUnknown) {
     throw InputError("--device: '" + o.device +

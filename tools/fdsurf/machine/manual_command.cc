@@ -68,12 +68,7 @@ Settings Resolve(const ManualOptions& o) {
     s.profile = LoadMachineProfile(FindMachineProfile(o.machine));
     ApplyMachineProfile(s.profile, stream);
   }
-  const std::string served = ServedGpioLink(s.stream.device);
-  if (!served.empty()) {
-    if (!o.quiet)
-      std::fprintf(stderr, "fdsurf: %s is served at %s\n", s.stream.device.c_str(), served.c_str());
-    s.stream.device = "serial:" + served;
-  }
+  s.stream.device = DeviceThroughServer(s.stream.device, o.quiet);
   s.machine = StreamMachine(s.stream);
   if (!(s.machine.travel[0] > 0)) {
     throw InputError(

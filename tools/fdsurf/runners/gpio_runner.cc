@@ -19,8 +19,7 @@ namespace {
 // Everything a job on the GPIO lines runs with, apart from the Device.
 struct GpioRig {
   GpioRig(GpioLines& gpio_lines, std::uint32_t tick_hz, bool quiet)
-      // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
-      : ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz),
+      : ticks(clock, hal::TickScheduler::PeriodOf(tick_hz)),
         link(LinkOptions()),
         lines(gpio_lines),
         progress(ShowProgress(quiet)) {}

@@ -30,8 +30,7 @@ constexpr std::uint64_t kHaltTimeUs = 200'000;
 // What serving runs with, apart from the Device.
 struct Server {
   Server(GpioLines& gpio_lines, hal::PtyTransport& port, std::uint32_t tick_hz)
-      // The period rounded up: a tick rate above tick_hz would be a speed above the limit.
-      : ticks(clock, (1'000'000 + tick_hz - 1) / tick_hz), lines(gpio_lines), pty(port) {}
+      : ticks(clock, hal::TickScheduler::PeriodOf(tick_hz)), lines(gpio_lines), pty(port) {}
 
   hal::MonotonicClock clock;
   hal::TickScheduler ticks;
@@ -135,22 +134,8 @@ class ServedDeviceNote {
   std::string path_;
 };
 
-std::uint16_t ServoWidth(int us, const char* flag) {
-  if (us != 0 && (us < 500 || us > 2500)) {
-    throw InputError(std::string(flag) + ": " + std::to_string(us) +
-                     " µs is not a servo pulse width (500..2500)");
-  }
-  return static_cast<std::uint16_t>(us);
-}
-
-}  // namespace
-
-std::string DefaultServeLink() {
-  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
-  const std::string dir = runtime != nullptr && runtime[0] == '/' ? runtime : "/tmp";
-  return dir + "/fdsurf-gpio";
-}
-
+// The link (a path) when a running `serve` publishes `device` at the
+// default link, else "".
 std::string ServedGpioLink(const std::string& device) {
   std::string link = DefaultServeLink();
   std::ifstream note(link + ".device");
@@ -161,6 +146,30 @@ std::string ServedGpioLink(const std::string& device) {
   std::error_code error;
   if (served != device || !std::filesystem::exists(link, error)) return "";
   return link;
+}
+
+std::uint16_t ServoWidth(int us, const char* flag) {
+  if (us != 0 && (us < 500 || us > 2500)) {
+    throw InputError(std::string(flag) + ": " + std::to_string(us) +
+                     " µs is not a servo pulse width (500..2500)");
+  }
+  return static_cast<std::uint16_t>(us);
+}
+
+}  // namespace
+
+std::string DeviceThroughServer(const std::string& device, bool quiet) {
+  if (device.rfind("gpio:", 0) != 0) return device;
+  const std::string served = ServedGpioLink(device);
+  if (served.empty()) return device;
+  if (!quiet) std::fprintf(stderr, "fdsurf: %s is served at %s\n", device.c_str(), served.c_str());
+  return "serial:" + served;
+}
+
+std::string DefaultServeLink() {
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  const std::string dir = runtime != nullptr && runtime[0] == '/' ? runtime : "/tmp";
+  return dir + "/fdsurf-gpio";
 }
 
 int ServeGpio(const ServeOptions& o) {

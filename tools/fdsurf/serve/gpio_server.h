@@ -27,11 +27,12 @@ struct ServeOptions {
 /// $XDG_RUNTIME_DIR/fdsurf-gpio, or /tmp/fdsurf-gpio without it.
 std::string DefaultServeLink();
 
-/// The link (a path) when a running `serve` publishes `device` (a gpio:… spec,
-/// compared as written) at DefaultServeLink(), else "". `serve` writes the
-/// spec it drives beside its link, as LINK.device, while it runs; `stream`
-/// and `machine` given that gpio device go through it then, as serial:LINK.
-std::string ServedGpioLink(const std::string& device);
+/// The device a command given `device` talks to: "serial:LINK" when a
+/// running `serve` publishes that gpio:… spec (compared as written) at
+/// DefaultServeLink(), saying so on stderr unless `quiet`; else `device`
+/// as it is. `serve` writes the spec it drives beside its link, as
+/// LINK.device, while it runs; `stream` and `machine` call this.
+std::string DeviceThroughServer(const std::string& device, bool quiet);
 
 /// Serves until SIGINT or SIGTERM. Then the device stops as on STOP
 /// (decelerating along its path, 10 s at most; a second signal halts at

@@ -31,6 +31,10 @@ class TickScheduler {
   /// `period_us` ≥ 1. The first tick is due at once.
   TickScheduler(Clock& clock, uint64_t period_us) : clock_(clock), period_us_(period_us) {}
 
+  /// The period of `tick_hz` (≥ 1) ticks a second, µs, rounded up: a rate
+  /// above tick_hz would be a speed above the device's limits.
+  static uint64_t PeriodOf(uint32_t tick_hz) { return (1'000'000u + tick_hz - 1) / tick_hz; }
+
   /// Sleeps until the next tick is due and returns the clock's time on
   /// waking: the time of this tick. Successive results are at least one
   /// period apart, however late any wake-up was.
