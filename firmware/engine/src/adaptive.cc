@@ -132,6 +132,7 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   PreparedAdaptiveCurve<kDims> result;
   result.format.acc_bits = static_cast<uint8_t>(acc_bits);
   result.format.frac_bits = static_cast<uint8_t>(frac_bits);
+  result.format.word_aligned = 0;  // The cursor halves and doubles its steps.
   result.finest_level = static_cast<uint8_t>(level);
   result.mode = settings.mode;
   for (int c = 0; c < kDims; ++c) {

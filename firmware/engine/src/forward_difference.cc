@@ -273,6 +273,21 @@ uint8_t LineFracBits(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
   return static_cast<uint8_t>(frac_bits);
 }
 
+// A word-aligned 64-bit stepper (docs/precision.md, "Word-aligned stepping")
+// holds every entry with 32 fractional bits and the position with the
+// rounding half added: each bound plus 2 quanta must stay below 2^31 quanta,
+// so that (B + 2)·2^32 < 2^63.
+bool FitsWordAligned(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d) {
+  const Wide limit = d.value.ShiftedLeft(31);
+  const Wide margin = d.value + d.value;
+  for (int k = 0; k < s.size; ++k) {
+    for (int l = 0; l < t.size; ++l) {
+      if (!(plane.bound[k][l] + margin < limit)) return false;
+    }
+  }
+  return true;
+}
+
 // Positions themselves (plus a quantum) must fit the int32_t output.
 bool FitsOutput(const Plane& plane, const Denominator& d) {
   return plane.bound[0][0] + d.value < d.value.ShiftedLeft(31);
@@ -330,6 +345,11 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   }
   format->acc_bits = static_cast<uint8_t>(acc_bits);
   format->frac_bits = static_cast<uint8_t>(frac_bits);
+  bool word_aligned = acc_bits == 64 && frac_bits <= 32;
+  for (int c = 0; c < kDims && word_aligned; ++c) {
+    word_aligned = FitsWordAligned(planes[c], s, t, denominator);
+  }
+  format->word_aligned = word_aligned ? 1 : 0;
   *exact = all_exact;
   if (line_frac_bits != nullptr) {
     const bool wide = acc_bits == 128 && t.size == 4;

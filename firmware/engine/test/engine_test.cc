@@ -314,6 +314,100 @@ TEST(PatchEngine, ChoosesTheNarrowestAccumulator) {
   EXPECT_EQ(prepared.format.acc_bits, 128);
 }
 
+// Word-aligned stepping (docs/precision.md): a 64-bit table with F <= 32
+// is stepped with 32 fractional bits and the rounding half in the position,
+// and a point is the position's high word. It must give exactly the bits of
+// the table as planned, stepped by the independent 128-bit stepper, which
+// ignores the alignment and rounds every point with RoundToQuanta.
+TEST(PatchEngine, WordAlignedSteppingGivesTheBitsOfThePlannedTable) {
+  std::mt19937_64 rng(23);
+  const int grids[][2] = {{1, 1}, {3, 5}, {16, 16}, {17, 17}, {25, 25}, {40, 7}, {1, 60}};
+  int aligned = 0;
+  for (Basis basis : kAllBases) {
+    for (const auto& grid : grids) {
+      // ±2^17 quanta: 131 mm at 1 µm. At ±2^20 a 1×1 grid's differences
+      // (bounded over [0, 4]²) can pass 2^31 quanta, and the table is then
+      // not aligned (PrecisionPlanner.WordAlignsOnlyWhatFits).
+      const RawPatch patch = RandomPatch(rng, basis, 1 << 17);
+      PreparedPatch<3> prepared;
+      ASSERT_EQ(Prepare(patch, basis, grid[0], grid[1], &prepared), Status::kOk);
+      ASSERT_EQ(prepared.format.acc_bits, 64);
+      ASSERT_LE(prepared.format.frac_bits, 32) << grid[0] << "x" << grid[1];
+      ASSERT_EQ(prepared.format.word_aligned, 1) << BasisName(basis) << " " << grid[0];
+      ++aligned;
+      const std::size_t points = static_cast<std::size_t>(grid[0] + 1) * (grid[1] + 1);
+      GridPoints word_s{grid[0], grid[1], std::vector<std::int32_t>(3 * points)};
+      GridPoints word_t = word_s;
+      GridPoints wide_s = word_s;
+      GridPoints wide_t = word_s;
+      Step<std::int64_t>(prepared, &word_s, &word_t);
+      Step<Int128>(prepared, &wide_s, &wide_t);
+      EXPECT_EQ(word_s.xyz, wide_s.xyz) << BasisName(basis) << " " << grid[0] << "x" << grid[1];
+      EXPECT_EQ(word_t.xyz, wide_t.xyz) << BasisName(basis) << " " << grid[0] << "x" << grid[1];
+    }
+  }
+  EXPECT_EQ(aligned, 35);
+}
+
+TEST(CurveEngine, WordAlignedSteppingGivesTheBitsOfThePlannedTable) {
+  std::mt19937_64 rng(29);
+  for (Basis basis : kAllBases) {
+    for (int n : {1, 2, 7, 256, 300, 369}) {
+      CurveGeometry1 geometry[3];
+      std::uniform_real_distribution<double> dist(-(1 << 20), 1 << 20);
+      for (auto& coordinate : geometry) {
+        for (auto& g : coordinate.g) {
+          g = GeometryFixed::FromRaw(static_cast<std::int64_t>(dist(rng) * kOneQuantumRaw));
+        }
+      }
+      PreparedCurve<3> curve;
+      ASSERT_EQ(PrepareCurve(geometry, basis, static_cast<std::uint16_t>(n), {}, &curve),
+                Status::kOk);
+      ASSERT_EQ(curve.format.word_aligned, 1) << BasisName(basis) << " n=" << n;
+      std::vector<std::int32_t> word;
+      std::vector<std::int32_t> wide;
+      CurveStepper<std::int64_t, 3>(curve).ForEachPoint(
+          [&](std::uint32_t, const std::int32_t(&p)[3]) { word.insert(word.end(), p, p + 3); });
+      CurveStepper<Int128, 3>(curve).ForEachPoint(
+          [&](std::uint32_t, const std::int32_t(&p)[3]) { wide.insert(wide.end(), p, p + 3); });
+      EXPECT_EQ(word, wide) << BasisName(basis) << " n=" << n;
+    }
+  }
+}
+
+// The planner aligns only what fits: not when F > 32 (the high word would
+// drop fractional bits), not when a difference comes within 2 quanta of
+// 2^31 (the moved table would not fit 64 bits).
+TEST(PrecisionPlanner, WordAlignsOnlyWhatFits) {
+  std::mt19937_64 rng(31);
+  const RawPatch patch = RandomPatch(rng, Basis::kBezier, 2000);
+  PreparedPatch<3> prepared;
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 25, 25, &prepared), Status::kOk);
+  EXPECT_EQ(prepared.format.frac_bits, 32);
+  EXPECT_EQ(prepared.format.word_aligned, 1);
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 26, 26, &prepared), Status::kOk);
+  EXPECT_EQ(prepared.format.frac_bits, 33);
+  EXPECT_EQ(prepared.format.acc_bits, 64);
+  EXPECT_EQ(prepared.format.word_aligned, 0);
+
+  // x(t) = a·t³, one step: the position stays within a, but the second
+  // difference's bound over [0, 3] is 18·a (docs/precision.md, step 5). It
+  // aligns while 18·a + 2 < 2^31, that is up to a = 119 304 646 quanta.
+  const auto one_step_power_curve = [](std::int64_t a_quanta, PreparedCurve<1>* curve) {
+    CurveGeometry1 geometry[1];
+    geometry[0].g[0] = GeometryFixed::FromRaw(a_quanta * kOneQuantumRaw);
+    for (int k = 1; k < 4; ++k) geometry[0].g[k] = GeometryFixed::FromRaw(0);
+    return PrepareCurve(geometry, Basis::kPower, 1, {}, curve);
+  };
+  PreparedCurve<1> curve;
+  ASSERT_EQ(one_step_power_curve(119304646, &curve), Status::kOk);
+  EXPECT_EQ(curve.format.acc_bits, 64);
+  EXPECT_EQ(curve.format.word_aligned, 1);
+  ASSERT_EQ(one_step_power_curve(119304647, &curve), Status::kOk);
+  EXPECT_EQ(curve.format.acc_bits, 64);
+  EXPECT_EQ(curve.format.word_aligned, 0);
+}
+
 TEST(PrecisionPlanner, RequiredLineFracBitsMatchTheDerivation) {
   // bitlength(S(n)) + 7: S(1024) = 178 957 825 < 2^28, S(256) = 2 796 417 < 2^22,
   // S(40) = 10 701 < 2^14.
@@ -366,7 +460,7 @@ TEST(PrecisionPlanner, RefusesWhatItCannotServe) {
   std::mt19937_64 rng(17);
   RawPatch patch = RandomPatch(rng, Basis::kBezier, 1000);
   PreparedPatch<3> prepared;
-  prepared.format = {0, 0};
+  prepared.format = {0, 0, 0};
   EXPECT_EQ(Prepare(patch, Basis::kBezier, 0, 4, &prepared), Status::kGridOutOfRange);
   EXPECT_EQ(Prepare(patch, Basis::kBezier, 4, 1025, &prepared), Status::kGridOutOfRange);
   EXPECT_EQ(Prepare(patch, static_cast<Basis>(9), 4, 4, &prepared), Status::kInvalidArgument);

@@ -43,6 +43,13 @@ constexpr int kLineGuardBits = 7;
 struct DiffFormat {
   uint8_t acc_bits;   // 64 or 128
   uint8_t frac_bits;  // F
+  /// 1 when a 64-bit stepper may hold the table with 32 fractional bits
+  /// (moved left by 32 − F) and the rounding half added to the position, so
+  /// that a point is the position's high word: no shift and no add per point
+  /// (docs/precision.md, "Word-aligned stepping"). Planned for 64-bit tables
+  /// with F ≤ 32 whose differences stay below 2^31 − 2 quanta; 0 otherwise,
+  /// and then the stepper rounds with RoundToQuanta.
+  uint8_t word_aligned;
 };
 
 /// What callers may limit or (in tests only) weaken.
@@ -128,6 +135,59 @@ inline void Load(const Int128& from, int64_t* to) {
 }
 inline void Load(const Int128& from, Int128* to) { *to = from; }
 
+/// Loads a table entry into a stepper's accumulator in the stepping format:
+/// for a word-aligned 64-bit table (DiffFormat::word_aligned) moved to 32
+/// fractional bits, with the rounding half added to the position
+/// (`position`: entry 0 of a curve, entry (0,0) of a patch). The shift is
+/// exact and the planner proved the range. Out of line: it runs once per
+/// entry at set-up, and a copy in every stepper's constructor costs an 8-bit
+/// target's flash.
+__attribute__((noinline)) inline void Load(const Int128& from, const DiffFormat& format,
+                                           bool position, int64_t* to) {
+  const int64_t value = static_cast<int64_t>(from.lo);
+  if (format.word_aligned == 0) {
+    *to = value;
+    return;
+  }
+  const int64_t moved = format.frac_bits == 32 ? value : ShiftLeft(value, 32 - format.frac_bits);
+  *to = position ? moved + (int64_t{1} << 31) : moved;
+}
+inline void Load(const Int128& from, const DiffFormat& /*format*/, bool /*position*/, Int128* to) {
+  *to = from;
+}
+
+#if defined(__AVR__)
+/// RoundToQuanta out of line: on an 8-bit core its run-time 64-bit shifts
+/// are long, and a copy in every stepper costs more flash than the call
+/// costs time. Only tables that are not word-aligned take this path.
+#define FDSURF_ROUND_POSITION_ATTRIBUTES __attribute__((noinline))
+#else
+#define FDSURF_ROUND_POSITION_ATTRIBUTES
+#endif
+FDSURF_ROUND_POSITION_ATTRIBUTES inline int32_t RoundPosition(int64_t position, int frac_bits) {
+  return RoundToQuanta(position, frac_bits);
+}
+#undef FDSURF_ROUND_POSITION_ATTRIBUTES
+
+/// A position in the stepping format, rounded to whole quanta: the high word
+/// of a word-aligned one (floor((x·2^(32−F) + 2^31) / 2^32) = floor(x·2^-F + ½),
+/// the same bits as RoundToQuanta), else RoundToQuanta.
+/// The high word is read as the upper 4 bytes of the position where the
+/// byte order allows (avr-gcc otherwise calls __lshrdi3 for the shift by 32).
+inline int32_t PositionQuanta(const int64_t& position, bool word_aligned, int frac_bits) {
+  if (!word_aligned) return RoundPosition(position, frac_bits);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+  uint32_t high;
+  __builtin_memcpy(&high, reinterpret_cast<const unsigned char*>(&position) + 4, 4);
+  return ToInt32(high);
+#else
+  return ToInt32(static_cast<uint32_t>(static_cast<uint64_t>(position) >> 32));
+#endif
+}
+inline int32_t PositionQuanta(const Int128& position, bool /*word_aligned*/, int frac_bits) {
+  return RoundToQuanta(position, frac_bits);
+}
+
 /// round(value·2^-shift) as an int64_t, halves up: a table entry of the
 /// wide format moved to a line's format, `shift` = 1..63 bits fewer. The
 /// planner proved that the result fits (docs/precision.md).
@@ -144,6 +204,39 @@ inline void Step(Acc* d) {
   d[2] += d[3];
 }
 
+#if defined(__AVR__)
+/// The row-add update of a 64-bit vector on AVR. avr-gcc makes each 64-bit
+/// add a call to `__adddi3` with both operands moved through 16 registers
+/// (about 100 cycles); here the three adds walk the 32 contiguous bytes of
+/// d[0..3] with two pointers, Z on the sum and X on the addend one entry
+/// later, each an add-with-carry chain of 8 bytes, unrolled: 7 cycles a
+/// byte, 168 for the vector, in 192 bytes of flash. After d[0] += d[1] the
+/// pointers sit on d[1] and d[2], so the next add follows with no set-up;
+/// d[1] is read before it is changed, as in the generic version. Out of
+/// line: one copy serves every stepper.
+__attribute__((noinline)) inline void Step(int64_t* d) {
+  unsigned char* sum = reinterpret_cast<unsigned char*>(d);
+  const unsigned char* addend = reinterpret_cast<const unsigned char*>(d + 1);
+  unsigned char scratch;
+  asm volatile(
+      ".rept 3\n\t"
+      "ld __tmp_reg__, X+\n\t"
+      "ld %[s], Z\n\t"
+      "add %[s], __tmp_reg__\n\t"
+      "st Z+, %[s]\n\t"
+      ".rept 7\n\t"
+      "ld __tmp_reg__, X+\n\t"
+      "ld %[s], Z\n\t"
+      "adc %[s], __tmp_reg__\n\t"
+      "st Z+, %[s]\n\t"
+      ".endr\n\t"
+      ".endr"
+      : [s] "=&r"(scratch), "+z"(sum), "+x"(addend)
+      :
+      : "memory");
+}
+#endif
+
 }  // namespace internal
 
 /// Steps a prepared curve with accumulator Acc (int64_t or Int128; int64_t
@@ -153,9 +246,11 @@ template <typename Acc, int kDims>
 class CurveStepper {
  public:
   explicit CurveStepper(const PreparedCurve<kDims>& curve)
-      : frac_bits_(curve.format.frac_bits), steps_(curve.steps) {
+      : frac_bits_(curve.format.frac_bits),
+        word_aligned_(curve.format.word_aligned != 0),
+        steps_(curve.steps) {
     for (int c = 0; c < kDims; ++c) {
-      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], curve.format, k == 0, &d_[c][k]);
     }
   }
 
@@ -167,7 +262,9 @@ class CurveStepper {
     }
     int32_t point[kDims];
     for (uint32_t i = 0;; ++i) {
-      for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(d[c][0], frac_bits_);
+      for (int c = 0; c < kDims; ++c) {
+        point[c] = internal::PositionQuanta(d[c][0], word_aligned_, frac_bits_);
+      }
       sink(i, point);
       if (i == steps_) break;
       for (int c = 0; c < kDims; ++c) internal::Step(d[c]);
@@ -177,6 +274,7 @@ class CurveStepper {
  private:
   Acc d_[kDims][4];
   int frac_bits_;
+  bool word_aligned_;
   uint16_t steps_;
 };
 
@@ -185,10 +283,15 @@ template <typename Acc, int kDims>
 class PatchStepper {
  public:
   explicit PatchStepper(const PreparedPatch<kDims>& patch)
-      : frac_bits_(patch.format.frac_bits), steps_s_(patch.steps_s), steps_t_(patch.steps_t) {
+      : frac_bits_(patch.format.frac_bits),
+        word_aligned_(patch.format.word_aligned != 0),
+        steps_s_(patch.steps_s),
+        steps_t_(patch.steps_t) {
     for (int c = 0; c < kDims; ++c) {
       for (int k = 0; k < 4; ++k) {
-        for (int l = 0; l < 4; ++l) internal::Load(patch.dd[c][k][l], &dd_[c][k][l]);
+        for (int l = 0; l < 4; ++l) {
+          internal::Load(patch.dd[c][k][l], patch.format, k == 0 && l == 0, &dd_[c][k][l]);
+        }
       }
     }
   }
@@ -208,7 +311,9 @@ class PatchStepper {
         for (int l = 0; l < 4; ++l) line[c][l] = dd[c][0][l];
       }
       for (uint32_t j = 0;; ++j) {
-        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], frac_bits_);
+        for (int c = 0; c < kDims; ++c) {
+          point[c] = internal::PositionQuanta(line[c][0], word_aligned_, frac_bits_);
+        }
         sink(i, j, point);
         if (j == steps_t_) break;
         for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
@@ -238,7 +343,9 @@ class PatchStepper {
         for (int k = 0; k < 4; ++k) line[c][k] = dd[c][k][0];
       }
       for (uint32_t i = 0;; ++i) {
-        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], frac_bits_);
+        for (int c = 0; c < kDims; ++c) {
+          point[c] = internal::PositionQuanta(line[c][0], word_aligned_, frac_bits_);
+        }
         sink(i, j, point);
         if (i == steps_s_) break;
         for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
@@ -261,6 +368,7 @@ class PatchStepper {
 
   Acc dd_[kDims][4][4];
   int frac_bits_;
+  bool word_aligned_;
   uint16_t steps_s_;
   uint16_t steps_t_;
 };
