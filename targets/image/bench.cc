@@ -82,12 +82,14 @@ void BenchEngineAdaptive(const PreparedAdaptiveCurve<2>& curve) {
 
 // Where the engine's time goes, for the 2-D curve: the row-add update
 // alone, and the rounding to whole quanta alone, per point (the engine's own
-// inline functions, on the same table).
+// inline functions, on the same table in the stepper's format: word-aligned
+// where the planner allows it, docs/precision.md).
+#if !FDSURF_IMAGE_SMALL_BENCH
 __attribute__((noinline)) void BenchEngineParts(const PreparedCurve<2>& curve) {
   if (curve.format.acc_bits != 64) return;
   int64_t d[2][4];
   for (int c = 0; c < 2; ++c) {
-    for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d[c][k]);
+    for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], curve.format, k == 0, &d[c][k]);
   }
   PortMark();
   for (uint16_t i = 0; i <= curve.steps; ++i) {
@@ -99,13 +101,17 @@ __attribute__((noinline)) void BenchEngineParts(const PreparedCurve<2>& curve) {
   PortMark();
   PutBenchLine(FDSURF_TEXT("engine-step-only"), 2, curve.steps + 1u, 64);
   const int frac_bits = curve.format.frac_bits;
+  const bool word_aligned = curve.format.word_aligned != 0;
   PortMark();
   for (uint16_t i = 0; i <= curve.steps; ++i) {
-    for (int c = 0; c < 2; ++c) g_sink[c] = RoundToQuanta(d[c][0] + i, frac_bits);
+    for (int c = 0; c < 2; ++c) {
+      g_sink[c] = internal::PositionQuanta(d[c][0] + i, word_aligned, frac_bits);
+    }
   }
   PortMark();
   PutBenchLine(FDSURF_TEXT("engine-round-only"), 2, curve.steps + 1u, 64);
 }
+#endif
 
 // --- The alternatives, as a firmware author would write them. ---
 
@@ -284,7 +290,9 @@ __attribute__((noinline)) void BenchCurves2(const BenchSource& source) {
   PreparedCurve<2>& curve = g_table.curve2;
   source.curve2(false, &curve);
   BenchEngineCurve(FDSURF_TEXT("engine-curve"), curve);
-  BenchEngineParts(curve);
+#if !FDSURF_IMAGE_SMALL_BENCH
+  if (source.parts) BenchEngineParts(curve);
+#endif
   BenchDeCasteljau<2>();
   BenchFloatHorner<2>();
   BenchFixedHorner<2>();
@@ -294,6 +302,7 @@ __attribute__((noinline)) void BenchCurves2(const BenchSource& source) {
   }
 }
 
+#if !FDSURF_IMAGE_SMALL_BENCH
 __attribute__((noinline)) void BenchCurves3(const BenchSource& source) {
   PreparedCurve<3>& curve = g_table.curve3;
   source.curve3(&curve);
@@ -302,6 +311,7 @@ __attribute__((noinline)) void BenchCurves3(const BenchSource& source) {
   BenchFloatHorner<3>();
   BenchFixedHorner<3>();
 }
+#endif
 
 __attribute__((noinline)) void BenchPatch2(const BenchSource& source) {
   PreparedPatch<2>& patch = g_table.patch2;
@@ -394,7 +404,9 @@ void RunBench(const BenchSource& source) {
   if (source.measure_setup) BenchSetup();
 #endif
   BenchCurves2(source);
-  BenchCurves3(source);
+#if !FDSURF_IMAGE_SMALL_BENCH
+  if (source.curve3 != nullptr) BenchCurves3(source);
+#endif
   BenchPatch2(source);
 #if FDSURF_IMAGE_SETUP
   if (source.patch3 != nullptr) BenchPatch3(source);

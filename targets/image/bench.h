@@ -47,13 +47,18 @@ void BenchCurveGeometry(bool wide, CurveGeometry1 (&geometry)[kDims]) {
 /// from host-prepared tables (ATmega328P).
 struct BenchSource {
   void (*curve2)(bool wide, PreparedCurve<2>* out);
-  void (*curve3)(PreparedCurve<3>* out);
+  void (*curve3)(PreparedCurve<3>* out);  // nullptr: not on this target
   void (*patch2)(PreparedPatch<2>* out);
   void (*patch3)(PreparedPatch<3>* out);  // nullptr: not on this target
   void (*adaptive2)(PreparedAdaptiveCurve<2>* out);
   bool measure_setup;
   /// Whether to measure the 128-bit accumulator (the wide curve).
   bool wide;
+  /// Whether to measure the 2-D curve's row-add and rounding apart
+  /// (engine-step-only, engine-round-only). The ATmega328P image has no
+  /// room for that code or for the 3-D curve bench
+  /// (FDSURF_IMAGE_SMALL_BENCH); the host's --small leaves them out too.
+  bool parts;
 };
 
 /// Runs every measured loop and prints its bench line.

@@ -67,7 +67,6 @@ void RunRomCases(Reporter& reporter) {
 }
 
 void LoadBenchCurve2(bool wide, PreparedCurve<2>* out) { Load(kRomBenchCurve2[wide ? 1 : 0], out); }
-void LoadBenchCurve3(PreparedCurve<3>* out) { Load(kRomBenchCurve3, out); }
 void LoadBenchPatch2(PreparedPatch<2>* out) { Load(kRomBenchPatch2, out); }
 void LoadBenchAdaptive2(PreparedAdaptiveCurve<2>* out) { Load(kRomBenchAdaptive2, out); }
 #endif
@@ -89,17 +88,20 @@ int RunImage(bool small_only) {
                         SetupBenchPatch3,
                         SetupBenchAdaptive2,
                         true,
+                        true,
                         true};
-  if (small_only) {
+  if (small_only) {  // What the ATmega328P image measures.
+    source.curve3 = nullptr;
     source.patch3 = nullptr;
     source.measure_setup = false;
     source.wide = false;
+    source.parts = false;
   }
 #else
   static_cast<void>(small_only);
   RunRomCases(reporter);
-  const BenchSource source = {
-      LoadBenchCurve2, LoadBenchCurve3, LoadBenchPatch2, nullptr, LoadBenchAdaptive2, false, false};
+  const BenchSource source = {LoadBenchCurve2,    nullptr, LoadBenchPatch2, nullptr,
+                              LoadBenchAdaptive2, false,   false,           false};
 #endif
   RunBench(source);
   PutString(FDSURF_TEXT("end\n"));

@@ -36,8 +36,8 @@ std::string Int128Text(const Int128& v) {
 
 std::string FormatText(const DiffFormat& f) {
   char text[32];
-  std::snprintf(text, sizeof text, "{%u, %u}", static_cast<unsigned>(f.acc_bits),
-                static_cast<unsigned>(f.frac_bits));
+  std::snprintf(text, sizeof text, "{%u, %u, %u}", static_cast<unsigned>(f.acc_bits),
+                static_cast<unsigned>(f.frac_bits), static_cast<unsigned>(f.word_aligned));
   return text;
 }
 
