@@ -242,35 +242,51 @@ bool FitsWidth(const Plane& plane, const Axis& s, const Axis& t, const Denominat
 
 // A line of the per-line stepper (docs/precision.md, "Per-line rounding")
 // holds the row-0 entries (s-lines) or the column-0 entries (t-lines) in
-// int64_t with `frac_bits` fractional bits: each of those bounds, plus a
-// quantum, must stay below 2^(63-F).
+// int64_t with `frac_bits` fractional bits, the position with the rounding
+// half added: each of those bounds, plus 2 quanta, must stay below
+// 2^(63-F).
 bool FitsLine(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d, bool s_lines,
               int frac_bits) {
   const int headroom = 63 - frac_bits;
   if (headroom < 1) return false;
   const Wide limit = d.value.ShiftedLeft(headroom);
+  const Wide margin = d.value + d.value;
   const int entries = s_lines ? t.size : s.size;
   for (int e = 0; e < entries; ++e) {
     const Wide& bound = s_lines ? plane.bound[0][e] : plane.bound[e][0];
-    if (!(bound + d.value < limit)) return false;
+    if (!(bound + margin < limit)) return false;
+  }
+  return true;
+}
+
+template <int kDims>
+bool AllLinesFit(const Plane (&planes)[kDims], const Axis& s, const Axis& t, const Denominator& d,
+                 bool s_lines, int frac_bits) {
+  for (int c = 0; c < kDims; ++c) {
+    if (!FitsLine(planes[c], s, t, d, s_lines, frac_bits)) return false;
   }
   return true;
 }
 
 // The line format of one family (0: none): planned for a table in the
 // 128-bit format whose lines have `line_steps` steps, if every coordinate's
-// line fits 64 bits with fewer fractional bits than the table's.
+// line fits 64 bits with fewer fractional bits than the table's. Where the
+// derivation asks for 32 bits or fewer and the range allows, the line gets
+// exactly 32, so that a point is its position's high word (the word-aligned
+// stepping of docs/precision.md); more bits only shrink the line's error.
 template <int kDims>
 uint8_t LineFracBits(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
                      const Denominator& d, bool s_lines, int table_frac_bits,
                      const PrepareOptions& options) {
   int frac_bits = RequiredLineFracBits(s_lines ? t.steps : s.steps);
+  const bool weakened = options.test_only_line_frac_bits_removed != 0;
   frac_bits -= options.test_only_line_frac_bits_removed;
   if (frac_bits < 1 || frac_bits >= table_frac_bits) return 0;
-  for (int c = 0; c < kDims; ++c) {
-    if (!FitsLine(planes[c], s, t, d, s_lines, frac_bits)) return 0;
+  if (!weakened && frac_bits <= 32 && 32 < table_frac_bits &&
+      AllLinesFit(planes, s, t, d, s_lines, 32)) {
+    return 32;
   }
-  return static_cast<uint8_t>(frac_bits);
+  return AllLinesFit(planes, s, t, d, s_lines, frac_bits) ? static_cast<uint8_t>(frac_bits) : 0;
 }
 
 // A word-aligned 64-bit stepper (docs/precision.md, "Word-aligned stepping")

@@ -196,6 +196,14 @@ inline int64_t RoundToLine(const Int128& value, int shift) {
   return static_cast<int64_t>(ShiftRightArithmetic(biased, shift).lo);
 }
 
+/// A line's position with the rounding half already added (LinePatchStepper),
+/// as whole quanta: floor(position·2^-frac_bits), the high word when the line
+/// has 32 fractional bits.
+inline int32_t LinePointQuanta(const int64_t& position, int frac_bits) {
+  if (frac_bits == 32) return PositionQuanta(position, true, 32);
+  return ToInt32(static_cast<uint32_t>(ShiftRightArithmetic(position, frac_bits)));
+}
+
 /// The row-add update of one difference vector: advance one step.
 template <typename Acc>
 inline void Step(Acc* d) {
@@ -377,8 +385,8 @@ class PatchStepper {
 /// 64-bit inner loop (docs/precision.md, "Per-line rounding"): the outer
 /// direction is stepped in the wide format, and at each line its difference
 /// vector is rounded once to the line's own format (s_line_frac_bits or
-/// t_line_frac_bits, which must be non-zero for the family stepped) and
-/// stepped in int64_t. Every point is within 0.51 quanta of the exact patch;
+/// t_line_frac_bits, which must be non-zero for the family stepped), the
+/// rounding half added to its position, and stepped in int64_t. Every point is within 0.51 quanta of the exact patch;
 /// s-lines and t-lines may differ by a quantum where the exact value is
 /// within about 0.002 quanta of a half (they round different lines).
 template <int kDims>
@@ -393,14 +401,18 @@ class LinePatchStepper {
     Copy(dd);
     const int line_bits = patch_.s_line_frac_bits;
     const int shift = patch_.format.frac_bits - line_bits;
+    // The rounding half rides in each line's position (the planner left 2
+    // quanta of range for it), so a point is a shift, or the high word.
+    const int64_t half = int64_t{1} << (line_bits - 1);
     int64_t line[kDims][4];
     int32_t point[kDims];
     for (uint32_t i = 0;; ++i) {
       for (int c = 0; c < kDims; ++c) {
         for (int l = 0; l < 4; ++l) line[c][l] = internal::RoundToLine(dd[c][0][l], shift);
+        line[c][0] += half;
       }
       for (uint32_t j = 0;; ++j) {
-        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], line_bits);
+        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
         sink(i, j, point);
         if (j == patch_.steps_t) break;
         for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
@@ -423,14 +435,18 @@ class LinePatchStepper {
     Copy(dd);
     const int line_bits = patch_.t_line_frac_bits;
     const int shift = patch_.format.frac_bits - line_bits;
+    // The rounding half rides in each line's position (the planner left 2
+    // quanta of range for it), so a point is a shift, or the high word.
+    const int64_t half = int64_t{1} << (line_bits - 1);
     int64_t line[kDims][4];
     int32_t point[kDims];
     for (uint32_t j = 0;; ++j) {
       for (int c = 0; c < kDims; ++c) {
         for (int k = 0; k < 4; ++k) line[c][k] = internal::RoundToLine(dd[c][k][0], shift);
+        line[c][0] += half;
       }
       for (uint32_t i = 0;; ++i) {
-        for (int c = 0; c < kDims; ++c) point[c] = RoundToQuanta(line[c][0], line_bits);
+        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
         sink(i, j, point);
         if (i == patch_.steps_s) break;
         for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
