@@ -196,8 +196,15 @@ class AdaptiveCurveCursor {
 
   /// Starts over on `curve`.
   void Reset(const PreparedAdaptiveCurve<kDims>& curve) {
+    // The rounding half rides in the position, which only ever has steps
+    // added to it (halving and doubling change d[1..3]), so a point is
+    // floor(d[0]·2^-F): no add per point. The planner's bound covers it
+    // (docs/toolpaths.md, "Choosing the finest level, and the range").
+    Acc half;
+    internal::RoundingHalf(curve.format.frac_bits, &half);
     for (int c = 0; c < kDims; ++c) {
       for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+      d_[c][0] += half;
     }
     internal::Load(curve.chord_limit, &chord_limit_);
     internal::Load(curve.step_limit, &step_limit_);
@@ -208,7 +215,7 @@ class AdaptiveCurveCursor {
     step_ = 1;
     step_exact_ = curve.mode == AdaptiveMode::kStepExact;
     started_ = false;
-    for (int c = 0; c < kDims; ++c) last_[c] = RoundToQuanta(d_[c][0], frac_bits_);
+    for (int c = 0; c < kDims; ++c) last_[c] = FloorToQuanta(d_[c][0], frac_bits_);
   }
 
   /// The next point in whole quanta and its position in units of
@@ -238,7 +245,7 @@ class AdaptiveCurveCursor {
       position_ += step_;
       bool moved = !step_exact_;
       for (int c = 0; c < kDims; ++c) {
-        point[c] = RoundToQuanta(d_[c][0], frac_bits_);
+        point[c] = FloorToQuanta(d_[c][0], frac_bits_);
         moved = moved || point[c] != last_[c];
       }
       if (moved) {

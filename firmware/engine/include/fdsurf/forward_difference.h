@@ -386,9 +386,9 @@ class PatchStepper {
 /// direction is stepped in the wide format, and at each line its difference
 /// vector is rounded once to the line's own format (s_line_frac_bits or
 /// t_line_frac_bits, which must be non-zero for the family stepped), the
-/// rounding half added to its position, and stepped in int64_t. Every point is within 0.51 quanta of the exact patch;
-/// s-lines and t-lines may differ by a quantum where the exact value is
-/// within about 0.002 quanta of a half (they round different lines).
+/// rounding half added to its position, and stepped in int64_t. Every point is within 0.51 quanta
+/// of the exact patch; s-lines and t-lines may differ by a quantum where the exact value is within
+/// about 0.002 quanta of a half (they round different lines).
 template <int kDims>
 class LinePatchStepper {
  public:

@@ -88,34 +88,61 @@ inline bool WithinMagnitude(const Int128& value, const Int128& limit) {
 
 }  // namespace internal
 
-/// Rounds value / 2^frac_bits to the nearest integer (halves upward).
-/// Requires 1 <= frac_bits <= 62 and a result that fits in int32_t, which the
-/// precision planner guarantees.
-inline int32_t RoundToQuanta(int64_t value, int frac_bits) {
-  const uint64_t biased = static_cast<uint64_t>(value) + (uint64_t{1} << (frac_bits - 1));
+/// floor(value / 2^frac_bits) as an int32_t: the whole quanta of a position
+/// whose rounding half is already added (the adaptive cursor and the per-line
+/// stepper keep it there). Requires 1 <= frac_bits <= 63 and a result that
+/// fits in int32_t, which the precision planner guarantees.
+inline int32_t FloorToQuanta(int64_t value, int frac_bits) {
   // Arithmetic shift written with unsigned operations: floor(x / 2^F) of a
   // negative x is ~(~x >> F).
-  const uint64_t shifted = (biased >> 63) != 0 ? ~(~biased >> frac_bits) : biased >> frac_bits;
+  const uint64_t bits = static_cast<uint64_t>(value);
+  const uint64_t shifted = (bits >> 63) != 0 ? ~(~bits >> frac_bits) : bits >> frac_bits;
   return internal::ToInt32(static_cast<uint32_t>(shifted));
 }
 
 /// As above for Int128; 1 <= frac_bits <= 126.
-inline int32_t RoundToQuanta(const Int128& value, int frac_bits) {
-  Int128 biased = value;
-  const Int128 half = frac_bits > 64 ? Int128{0, uint64_t{1} << (frac_bits - 65)}
-                                     : Int128{uint64_t{1} << (frac_bits - 1), 0};
-  biased += half;
-  const bool negative = (biased.hi >> 63) != 0;
-  uint64_t low_word;  // Bits frac_bits .. frac_bits + 63 of the sum.
+inline int32_t FloorToQuanta(const Int128& value, int frac_bits) {
+  const bool negative = (value.hi >> 63) != 0;
+  uint64_t low_word;  // Bits frac_bits .. frac_bits + 63 of the value.
   if (frac_bits < 64) {
-    low_word = (biased.lo >> frac_bits) | (biased.hi << (64 - frac_bits));
+    low_word = (value.lo >> frac_bits) | (value.hi << (64 - frac_bits));
   } else if (frac_bits == 64) {
-    low_word = biased.hi;
+    low_word = value.hi;
   } else {
     const int shift = frac_bits - 64;
-    low_word = negative ? ~(~biased.hi >> shift) : biased.hi >> shift;
+    low_word = negative ? ~(~value.hi >> shift) : value.hi >> shift;
   }
   return internal::ToInt32(static_cast<uint32_t>(low_word));
+}
+
+namespace internal {
+
+/// The rounding half 2^(frac_bits-1) in the accumulator's type.
+inline void RoundingHalf(int frac_bits, int64_t* half) {
+  *half = static_cast<int64_t>(uint64_t{1} << (frac_bits - 1));
+}
+inline void RoundingHalf(int frac_bits, Int128* half) {
+  *half = frac_bits > 64 ? Int128{0, uint64_t{1} << (frac_bits - 65)}
+                         : Int128{uint64_t{1} << (frac_bits - 1), 0};
+}
+
+}  // namespace internal
+
+/// Rounds value / 2^frac_bits to the nearest integer (halves upward).
+/// Requires 1 <= frac_bits <= 62 and a result that fits in int32_t, which the
+/// precision planner guarantees.
+inline int32_t RoundToQuanta(int64_t value, int frac_bits) {
+  int64_t half;
+  internal::RoundingHalf(frac_bits, &half);
+  return FloorToQuanta(
+      static_cast<int64_t>(static_cast<uint64_t>(value) + static_cast<uint64_t>(half)), frac_bits);
+}
+
+/// As above for Int128; 1 <= frac_bits <= 126.
+inline int32_t RoundToQuanta(const Int128& value, int frac_bits) {
+  Int128 half;
+  internal::RoundingHalf(frac_bits, &half);
+  return FloorToQuanta(value + half, frac_bits);
 }
 
 }  // namespace fdsurf
