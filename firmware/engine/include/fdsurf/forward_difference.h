@@ -156,18 +156,11 @@ inline void Load(const Int128& from, const DiffFormat& /*format*/, bool /*positi
   *to = from;
 }
 
-#if defined(__AVR__)
-/// RoundToQuanta out of line: on an 8-bit core its run-time 64-bit shifts
-/// are long, and a copy in every stepper costs more flash than the call
-/// costs time. Only tables that are not word-aligned take this path.
-#define FDSURF_ROUND_POSITION_ATTRIBUTES __attribute__((noinline))
-#else
-#define FDSURF_ROUND_POSITION_ATTRIBUTES
-#endif
-FDSURF_ROUND_POSITION_ATTRIBUTES inline int32_t RoundPosition(int64_t position, int frac_bits) {
+/// RoundToQuanta for the steppers' tables that are not word-aligned; out of
+/// line on AVR (FDSURF_OUT_OF_LINE_ON_AVR).
+FDSURF_OUT_OF_LINE_ON_AVR inline int32_t RoundPosition(int64_t position, int frac_bits) {
   return RoundToQuanta(position, frac_bits);
 }
-#undef FDSURF_ROUND_POSITION_ATTRIBUTES
 
 /// A position in the stepping format, rounded to whole quanta: the high word
 /// of a word-aligned one (floor((x·2^(32−F) + 2^31) / 2^32) = floor(x·2^-F + ½),

@@ -88,11 +88,20 @@ inline bool WithinMagnitude(const Int128& value, const Int128& limit) {
 
 }  // namespace internal
 
+#if defined(__AVR__)
+/// Out of line on 8-bit cores: there a run-time 64-bit shift is a long libgcc
+/// call, so a copy in every stepper costs far more flash than one call costs
+/// time.
+#define FDSURF_OUT_OF_LINE_ON_AVR __attribute__((noinline))
+#else
+#define FDSURF_OUT_OF_LINE_ON_AVR
+#endif
+
 /// floor(value / 2^frac_bits) as an int32_t: the whole quanta of a position
 /// whose rounding half is already added (the adaptive cursor and the per-line
 /// stepper keep it there). Requires 1 <= frac_bits <= 63 and a result that
 /// fits in int32_t, which the precision planner guarantees.
-inline int32_t FloorToQuanta(int64_t value, int frac_bits) {
+FDSURF_OUT_OF_LINE_ON_AVR inline int32_t FloorToQuanta(int64_t value, int frac_bits) {
   // Arithmetic shift written with unsigned operations: floor(x / 2^F) of a
   // negative x is ~(~x >> F).
   const uint64_t bits = static_cast<uint64_t>(value);
@@ -132,17 +141,16 @@ inline void RoundingHalf(int frac_bits, Int128* half) {
 /// Requires 1 <= frac_bits <= 62 and a result that fits in int32_t, which the
 /// precision planner guarantees.
 inline int32_t RoundToQuanta(int64_t value, int frac_bits) {
-  int64_t half;
-  internal::RoundingHalf(frac_bits, &half);
-  return FloorToQuanta(
-      static_cast<int64_t>(static_cast<uint64_t>(value) + static_cast<uint64_t>(half)), frac_bits);
+  const uint64_t biased = static_cast<uint64_t>(value) + (uint64_t{1} << (frac_bits - 1));
+  return FloorToQuanta(static_cast<int64_t>(biased), frac_bits);
 }
 
 /// As above for Int128; 1 <= frac_bits <= 126.
 inline int32_t RoundToQuanta(const Int128& value, int frac_bits) {
-  Int128 half;
-  internal::RoundingHalf(frac_bits, &half);
-  return FloorToQuanta(value + half, frac_bits);
+  Int128 biased = value;
+  biased += frac_bits > 64 ? Int128{0, uint64_t{1} << (frac_bits - 65)}
+                           : Int128{uint64_t{1} << (frac_bits - 1), 0};
+  return FloorToQuanta(biased, frac_bits);
 }
 
 }  // namespace fdsurf
