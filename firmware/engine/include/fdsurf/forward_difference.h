@@ -139,10 +139,10 @@ inline void Load(const Int128& from, Int128* to) { *to = from; }
 /// for a word-aligned 64-bit table (DiffFormat::word_aligned) moved to 32
 /// fractional bits, with the rounding half added to the position
 /// (`position`: entry 0 of a curve, entry (0,0) of a patch). The shift is
-/// exact and the planner proved the range. Out of line: it runs once per
-/// entry at set-up, and a copy in every stepper's constructor costs an 8-bit
-/// target's flash.
-__attribute__((noinline)) inline void Load(const Int128& from, const DiffFormat& format,
+/// exact and the planner proved the range. It runs once per entry when a
+/// stepper starts; out of line on AVR, where a copy in every stepper's
+/// constructor costs more flash than the call costs time.
+FDSURF_OUT_OF_LINE_ON_AVR inline void Load(const Int128& from, const DiffFormat& format,
                                            bool position, int64_t* to) {
   const int64_t value = static_cast<int64_t>(from.lo);
   if (format.word_aligned == 0) {
@@ -194,7 +194,7 @@ inline int64_t RoundToLine(const Int128& value, int shift) {
 /// has 32 fractional bits.
 inline int32_t LinePointQuanta(const int64_t& position, int frac_bits) {
   if (frac_bits == 32) return PositionQuanta(position, true, 32);
-  return ToInt32(static_cast<uint32_t>(ShiftRightArithmetic(position, frac_bits)));
+  return FloorToQuanta(position, frac_bits);
 }
 
 /// The row-add update of one difference vector: advance one step.
@@ -379,9 +379,10 @@ class PatchStepper {
 /// direction is stepped in the wide format, and at each line its difference
 /// vector is rounded once to the line's own format (s_line_frac_bits or
 /// t_line_frac_bits, which must be non-zero for the family stepped), the
-/// rounding half added to its position, and stepped in int64_t. Every point is within 0.51 quanta
-/// of the exact patch; s-lines and t-lines may differ by a quantum where the exact value is within
-/// about 0.002 quanta of a half (they round different lines).
+/// rounding half added to its position, and stepped in int64_t. Every point
+/// is within 0.51 quanta of the exact patch; s-lines and t-lines may differ
+/// by a quantum where the exact value is within about 0.002 quanta of a half
+/// (they round different lines).
 template <int kDims>
 class LinePatchStepper {
  public:
