@@ -194,8 +194,18 @@ TEST_F(GpioServe, AKilledJobIsResumedFromItsJournalDrawingTheSamePoints) {
 TEST_F(GpioServe, StoppingTheServerMidJobLeavesThePenUpAndTheDriversOff) {
   StartServer("0,0");
   const auto start = Clock::now();
-  const pid_t pid = Spawn(ZigzagJob() + " --reconnect-timeout 1");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  const std::string journal = (dir_ / "stop.journal").string();
+  const pid_t pid = Spawn(ZigzagJob() + " --reconnect-timeout 1 --journal '" + journal + "'");
+  // Stop once the carriage has left 0, 0 (the journal records the device's
+  // position from its status replies), not after a fixed time: under the
+  // sanitizers on a loaded machine the client took more than 1.5 s to start.
+  const auto deadline = Clock::now() + std::chrono::seconds(20);
+  while (Slurp(journal).find("position 0 0 0") != std::string::npos ||
+         Slurp(journal).find("position ") == std::string::npos) {
+    ASSERT_LT(Clock::now(), deadline)
+        << "the carriage did not move within 20 s: " << Slurp(dir_ / "bg.err");
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
   auto report = StopServer();
   EXPECT_EQ(report["exit_code"], "0") << ServerErr();
   EXPECT_NE(ServerErr().find("fdsurf serve: stopping the device"), std::string::npos)
