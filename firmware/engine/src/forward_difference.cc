@@ -225,19 +225,28 @@ Status BuildPlane(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Plane*
   return Status::kOk;
 }
 
+// Every difference of the table, plus `margin` quanta, stays below
+// 2^headroom quanta: bound/D + margin < 2^headroom, checked exactly as
+// bound + margin·D < D·2^headroom.
+bool TableBelow(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d,
+                int headroom, int64_t margin) {
+  const Wide limit = d.value.ShiftedLeft(headroom);
+  Wide margin_d = d.value;  // margin is 1 or 2: additions, not a wide product
+  for (int64_t i = 1; i < margin; ++i) margin_d += d.value;
+  for (int k = 0; k < s.size; ++k) {
+    for (int l = 0; l < t.size; ++l) {
+      if (!(plane.bound[k][l] + margin_d < limit)) return false;
+    }
+  }
+  return true;
+}
+
 // Every difference, plus one quantum for the accumulated rounding, must stay
 // below 2^(W-1) in units of 2^-F quanta: bound/D + 1 < 2^(W-1-F).
 bool FitsWidth(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d, int acc_bits,
                int frac_bits) {
   const int headroom = acc_bits - 1 - frac_bits;
-  if (headroom < 1) return false;
-  const Wide limit = d.value.ShiftedLeft(headroom);
-  for (int k = 0; k < s.size; ++k) {
-    for (int l = 0; l < t.size; ++l) {
-      if (!(plane.bound[k][l] + d.value < limit)) return false;
-    }
-  }
-  return true;
+  return headroom >= 1 && TableBelow(plane, s, t, d, headroom, 1);
 }
 
 // A line of the per-line stepper (docs/precision.md, "Per-line rounding")
@@ -294,14 +303,7 @@ uint8_t LineFracBits(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
 // rounding half added: each bound plus 2 quanta must stay below 2^31 quanta,
 // so that (B + 2)·2^32 < 2^63.
 bool FitsWordAligned(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d) {
-  const Wide limit = d.value.ShiftedLeft(31);
-  const Wide margin = d.value + d.value;
-  for (int k = 0; k < s.size; ++k) {
-    for (int l = 0; l < t.size; ++l) {
-      if (!(plane.bound[k][l] + margin < limit)) return false;
-    }
-  }
-  return true;
+  return TableBelow(plane, s, t, d, 31, 2);
 }
 
 // Positions themselves (plus a quantum) must fit the int32_t output.

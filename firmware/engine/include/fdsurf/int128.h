@@ -141,15 +141,18 @@ inline void RoundingHalf(int frac_bits, Int128* half) {
 /// Requires 1 <= frac_bits <= 62 and a result that fits in int32_t, which the
 /// precision planner guarantees.
 inline int32_t RoundToQuanta(int64_t value, int frac_bits) {
-  const uint64_t biased = static_cast<uint64_t>(value) + (uint64_t{1} << (frac_bits - 1));
+  int64_t half;
+  internal::RoundingHalf(frac_bits, &half);
+  // Added as unsigned: the sum is defined on every compiler.
+  const uint64_t biased = static_cast<uint64_t>(value) + static_cast<uint64_t>(half);
   return FloorToQuanta(static_cast<int64_t>(biased), frac_bits);
 }
 
 /// As above for Int128; 1 <= frac_bits <= 126.
 inline int32_t RoundToQuanta(const Int128& value, int frac_bits) {
-  Int128 biased = value;
-  biased += frac_bits > 64 ? Int128{0, uint64_t{1} << (frac_bits - 65)}
-                           : Int128{uint64_t{1} << (frac_bits - 1), 0};
+  Int128 biased;
+  internal::RoundingHalf(frac_bits, &biased);
+  biased += value;
   return FloorToQuanta(biased, frac_bits);
 }
 
