@@ -55,7 +55,8 @@ std::string Text(const PreparedPatch<kDims>& p) {
   std::string s = "{";
   s += FormatText(p.format) + ", " + std::to_string(p.steps_s) + ", " + std::to_string(p.steps_t) +
        ", " + (p.exact ? "true" : "false") + ", " + std::to_string(p.s_line_frac_bits) + ", " +
-       std::to_string(p.t_line_frac_bits) + ", {";
+       std::to_string(p.t_line_frac_bits) + ", " + std::to_string(p.s_line_segment_steps) + ", " +
+       std::to_string(p.t_line_segment_steps) + ", {";
   for (int c = 0; c < kDims; ++c) {
     s += "{";
     for (int k = 0; k < 4; ++k) {

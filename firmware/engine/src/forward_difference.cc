@@ -278,24 +278,34 @@ bool AllLinesFit(const Plane (&planes)[kDims], const Axis& s, const Axis& t, con
 }
 
 // The line format of one family (0: none): planned for a table in the
-// 128-bit format whose lines have `line_steps` steps, if every coordinate's
-// line fits 64 bits with fewer fractional bits than the table's. Where the
-// derivation asks for 32 bits or fewer and the range allows, the line gets
-// exactly 32, so that a point is its position's high word (the word-aligned
-// stepping of docs/precision.md); more bits only shrink the line's error.
+// 128-bit format, if every coordinate's line fits 64 bits with fewer
+// fractional bits than the table's. Where the range allows, the line gets
+// exactly 32 bits, so that a point is its position's high word (the
+// word-aligned stepping of docs/precision.md): a line whose derivation asks
+// for 32 bits or fewer keeps them all along (more bits only shrink its
+// error); a longer one (more than 369 steps) is cut into segments that need
+// 32 bits or fewer (LineSegmentSteps), each rounded from the line's exact
+// wide state at its start, so that its error term is a segment's. Else the
+// line gets the derivation's bits and is rounded once.
+struct LineFormat {
+  uint8_t frac_bits;       // 0: the family has no line format
+  uint16_t segment_steps;  // steps between re-roundings
+};
+
 template <int kDims>
-uint8_t LineFracBits(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
-                     const Denominator& d, bool s_lines, int table_frac_bits,
-                     const PrepareOptions& options) {
-  int frac_bits = RequiredLineFracBits(s_lines ? t.steps : s.steps);
+LineFormat PlanLineFormat(const Plane (&planes)[kDims], const Axis& s, const Axis& t,
+                          const Denominator& d, bool s_lines, int table_frac_bits,
+                          const PrepareOptions& options) {
+  const uint16_t steps = static_cast<uint16_t>(s_lines ? t.steps : s.steps);
+  int frac_bits = RequiredLineFracBits(steps);
   const bool weakened = options.test_only_line_frac_bits_removed != 0;
   frac_bits -= options.test_only_line_frac_bits_removed;
-  if (frac_bits < 1 || frac_bits >= table_frac_bits) return 0;
-  if (!weakened && frac_bits <= 32 && 32 < table_frac_bits &&
-      AllLinesFit(planes, s, t, d, s_lines, 32)) {
-    return 32;
+  if (frac_bits < 1 || frac_bits >= table_frac_bits) return {0, 0};
+  if (!weakened && 32 < table_frac_bits && AllLinesFit(planes, s, t, d, s_lines, 32)) {
+    return {32, LineSegmentSteps(steps)};
   }
-  return AllLinesFit(planes, s, t, d, s_lines, frac_bits) ? static_cast<uint8_t>(frac_bits) : 0;
+  if (!AllLinesFit(planes, s, t, d, s_lines, frac_bits)) return {0, 0};
+  return {static_cast<uint8_t>(frac_bits), steps};
 }
 
 // A word-aligned 64-bit stepper (docs/precision.md, "Word-aligned stepping")
@@ -314,7 +324,7 @@ bool FitsOutput(const Plane& plane, const Denominator& d) {
 template <int kDims>
 Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, const Axis& t,
                const PrepareOptions& options, DiffFormat* format, bool* exact,
-               Int128 (&table)[kDims][4][4], uint8_t (*line_frac_bits)[2] = nullptr) {
+               Int128 (&table)[kDims][4][4], LineFormat (*line_formats)[2] = nullptr) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
   if (GetBasisMatrix(basis) == nullptr) return Status::kInvalidArgument;
   const Denominator denominator = MakeDenominator(s, t);
@@ -369,11 +379,12 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   }
   format->word_aligned = word_aligned ? 1 : 0;
   *exact = all_exact;
-  if (line_frac_bits != nullptr) {
-    const bool wide = acc_bits == 128 && t.size == 4;
+  if (line_formats != nullptr) {
+    const bool lines = acc_bits == 128 && t.size == 4;
     for (int family = 0; family < 2; ++family) {
-      (*line_frac_bits)[family] =
-          wide ? LineFracBits(planes, s, t, denominator, family == 0, frac_bits, options) : 0;
+      (*line_formats)[family] =
+          lines ? PlanLineFormat(planes, s, t, denominator, family == 0, frac_bits, options)
+                : LineFormat{0, 0};
     }
   }
   return Status::kOk;
@@ -387,6 +398,13 @@ int RequiredFracBits(uint32_t steps_s, uint32_t steps_t) {
 
 int RequiredLineFracBits(uint32_t steps) {
   return BitLength(PropagationCount(steps)) + kLineGuardBits;
+}
+
+uint16_t LineSegmentSteps(uint16_t steps) {
+  for (uint32_t segments = 1;; ++segments) {
+    const uint32_t length = (steps + segments - 1) / segments;
+    if (RequiredLineFracBits(length) <= 32) return static_cast<uint16_t>(length);
+  }
 }
 
 template <int kDims>
@@ -434,12 +452,14 @@ Status PreparePatch(const PatchGeometry1 (&geometry)[kDims], Basis basis, uint16
     }
   }
   PreparedPatch<kDims> result;
-  uint8_t line_frac_bits[2];
+  LineFormat line_formats[2];
   const Status status =
-      Prepare(g, basis, s, t, options, &result.format, &result.exact, result.dd, &line_frac_bits);
+      Prepare(g, basis, s, t, options, &result.format, &result.exact, result.dd, &line_formats);
   if (status != Status::kOk) return status;
-  result.s_line_frac_bits = line_frac_bits[0];
-  result.t_line_frac_bits = line_frac_bits[1];
+  result.s_line_frac_bits = line_formats[0].frac_bits;
+  result.t_line_frac_bits = line_formats[1].frac_bits;
+  result.s_line_segment_steps = line_formats[0].segment_steps;
+  result.t_line_segment_steps = line_formats[1].segment_steps;
   result.steps_s = steps_s;
   result.steps_t = steps_t;
   *out = result;

@@ -105,17 +105,38 @@ void StepLines(const PreparedPatch<3>& prepared, std::vector<SteppedGrid>* grids
   const int n = prepared.steps_s;
   const int m = prepared.steps_t;
   const std::size_t points = static_cast<std::size_t>(n + 1) * (m + 1);
+  // Each point once, in order along the line (a segment's end is the next
+  // one's start and must not be emitted twice).
+  std::uint32_t calls = 0;
+  std::uint32_t last_along = 0;
+  bool in_order = true;
+  const auto visit = [&](std::uint32_t along) {
+    in_order = in_order && (along == 0 ? calls == 0 || last_along != 0 : along == last_along + 1);
+    last_along = along;
+    ++calls;
+  };
   if (prepared.s_line_frac_bits != 0) {
     grids->push_back({"per-line s-lines", {n, m, std::vector<std::int32_t>(3 * points)}});
     GridPoints& grid = grids->back().points;
     LinePatchStepper<3>(prepared).ForEachSLinePoint(
-        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) { grid.Put(i, j, p); });
+        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) {
+          visit(j);
+          grid.Put(i, j, p);
+        });
+    EXPECT_EQ(calls, points);
+    EXPECT_TRUE(in_order);
   }
+  calls = 0;
   if (prepared.t_line_frac_bits != 0) {
     grids->push_back({"per-line t-lines", {n, m, std::vector<std::int32_t>(3 * points)}});
     GridPoints& grid = grids->back().points;
     LinePatchStepper<3>(prepared).ForEachTLinePoint(
-        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) { grid.Put(i, j, p); });
+        [&](std::uint32_t i, std::uint32_t j, const std::int32_t(&p)[3]) {
+          visit(i);
+          grid.Put(i, j, p);
+        });
+    EXPECT_EQ(calls, points);
+    EXPECT_TRUE(in_order);
   }
 }
 
@@ -282,16 +303,18 @@ TEST(PatchEngine, PerLineRoundingSteps128BitTablesIn64BitLines) {
       PreparedPatch<3> prepared;
       ASSERT_EQ(Prepare(patch, basis, grid[0], grid[1], &prepared), Status::kOk);
       ASSERT_EQ(prepared.format.acc_bits, 128) << grid[0] << "x" << grid[1];
-      // The derivation's bits, or exactly 32 where it asks for 32 or fewer
-      // (a point is then the position's high word).
-      const auto planned = [](int steps) {
-        const int required = RequiredLineFracBits(static_cast<std::uint32_t>(steps));
-        return required <= 32 ? 32 : required;
+      // Exactly 32 bits (a point is then the position's high word); lines
+      // whose derivation asks for more are stepped in segments that ask for
+      // 32 or fewer: 1024 and 997 steps in 2 of at most 512 and 499.
+      const auto segment = [](int steps) {
+        return steps == 1024 ? 512 : steps == 997 ? 499 : steps;
       };
-      EXPECT_EQ(prepared.s_line_frac_bits, planned(grid[1]))
+      EXPECT_EQ(prepared.s_line_frac_bits, 32)
           << BasisName(basis) << " " << grid[0] << "x" << grid[1];
-      EXPECT_EQ(prepared.t_line_frac_bits, planned(grid[0]))
+      EXPECT_EQ(prepared.t_line_frac_bits, 32)
           << BasisName(basis) << " " << grid[0] << "x" << grid[1];
+      EXPECT_EQ(prepared.s_line_segment_steps, segment(grid[1]));
+      EXPECT_EQ(prepared.t_line_segment_steps, segment(grid[0]));
       EXPECT_EQ(CheckPatch(patch, basis, grid[0], grid[1]), 0);
     }
   }
@@ -421,6 +444,46 @@ TEST(PrecisionPlanner, RequiredLineFracBitsMatchTheDerivation) {
   EXPECT_EQ(RequiredLineFracBits(256), 22 + 7);
   EXPECT_EQ(RequiredLineFracBits(40), 14 + 7);
   EXPECT_EQ(RequiredLineFracBits(1), 2 + 7);
+}
+
+// Segments are the fewest of equal length (rounded up) whose lines need 32
+// fractional bits or fewer: bitlength(S(n)) + 7 ≤ 32 up to n = 586.
+TEST(PrecisionPlanner, LineSegmentsAreTheFewestThatNeed32Bits) {
+  EXPECT_EQ(RequiredLineFracBits(586), 32);
+  EXPECT_EQ(RequiredLineFracBits(587), 33);
+  EXPECT_EQ(LineSegmentSteps(586), 586);
+  EXPECT_EQ(LineSegmentSteps(587), 294);
+  EXPECT_EQ(LineSegmentSteps(1024), 512);
+  EXPECT_EQ(LineSegmentSteps(2000), 500);
+  EXPECT_EQ(LineSegmentSteps(65535), 586);  // 112 segments
+  for (std::uint32_t steps = 1; steps <= 4000; ++steps) {
+    const std::uint32_t length = LineSegmentSteps(static_cast<std::uint16_t>(steps));
+    const std::uint32_t segments = (steps + length - 1) / length;
+    ASSERT_LE(RequiredLineFracBits(length), 32) << steps;
+    if (segments > 1) {
+      const std::uint32_t fewer = (steps + segments - 2) / (segments - 1);
+      ASSERT_GT(RequiredLineFracBits(fewer), 32) << steps;
+    }
+  }
+}
+
+// Advancing a vector m steps at once is m row-add updates, negative and
+// wrapping values included (the stepper's own update is the reference).
+TEST(PatchEngine, AdvanceExactlyIsThatManySteps) {
+  std::mt19937_64 rng(23);
+  for (std::uint32_t steps : {0u, 1u, 2u, 3u, 17u, 499u, 512u, 586u, 2000u}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      Int128 advanced[4];
+      for (Int128& entry : advanced) entry = Int128{rng(), trial < 10 ? rng() : ~std::uint64_t{0}};
+      Int128 stepped[4];
+      for (int k = 0; k < 4; ++k) stepped[k] = advanced[k];
+      for (std::uint32_t i = 0; i < steps; ++i) internal::Step(stepped);
+      internal::AdvanceExactly(advanced, steps);
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_TRUE(advanced[k] == stepped[k]) << steps << " steps, entry " << k;
+      }
+    }
+  }
 }
 
 TEST(PrecisionPlanner, RequiredFracBitsMatchTheDerivation) {

@@ -101,6 +101,14 @@ struct PreparedPatch {
   /// bits, or when `format` is 64-bit already.
   uint8_t s_line_frac_bits;
   uint8_t t_line_frac_bits;
+  /// Under per-line rounding, the most steps a line is stepped in 64 bits
+  /// before it is re-rounded from its exact wide state (the line's own steps
+  /// when it is rounded once): long lines are cut into segments short
+  /// enough for 32 fractional bits, so that a point is the high word
+  /// (docs/precision.md, "Per-line rounding"). 0 where the family has no
+  /// line format.
+  uint16_t s_line_segment_steps;
+  uint16_t t_line_segment_steps;
   Int128 dd[kDims][4][4];
 };
 
@@ -111,6 +119,12 @@ int RequiredFracBits(uint32_t steps_s, uint32_t steps_t);
 /// The fractional bits of a line of `steps` steps under per-line rounding:
 /// bitlength(S(steps)) + kLineGuardBits.
 int RequiredLineFracBits(uint32_t steps);
+
+/// The segment length of a line of `steps` steps under per-line rounding
+/// with 32-bit lines: `steps` when RequiredLineFracBits(steps) ≤ 32, else
+/// ceil(steps / k) for the smallest number of segments k whose length
+/// needs 32 bits or fewer (1024 steps: 3 segments of at most 342).
+uint16_t LineSegmentSteps(uint16_t steps);
 
 /// Plans and sets up one curve coordinate by coordinate.
 /// Errors: kInvalidArgument (unknown basis, kDims out of 1..3),
@@ -195,6 +209,20 @@ inline int64_t RoundToLine(const Int128& value, int shift) {
 inline int32_t LinePointQuanta(const int64_t& position, int frac_bits) {
   if (frac_bits == 32) return PositionQuanta(position, true, 32);
   return FloorToQuanta(position, frac_bits);
+}
+
+/// Advances a difference vector `steps` steps at once, exactly: Δ^k after
+/// the steps is Σ_b C(steps, b)·Δ^(k+b), the closed form of that many
+/// row-add updates (Pascal's rule), so the result is what stepping would
+/// hold. Requires steps ≤ 2000 (C(steps, 3) < 2^32); the planner's range
+/// proof covers the result, and MultipliedBy wraps as the steps would.
+inline void AdvanceExactly(Int128 (&d)[4], uint32_t steps) {
+  const uint32_t c1 = steps;
+  const uint32_t c2 = steps * (steps - 1) / 2;
+  const uint32_t c3 = static_cast<uint32_t>(uint64_t{c2} * (steps - 2) / 3);
+  d[0] += MultipliedBy(d[1], c1) + MultipliedBy(d[2], c2) + MultipliedBy(d[3], c3);
+  d[1] += MultipliedBy(d[2], c1) + MultipliedBy(d[3], c2);
+  d[2] += MultipliedBy(d[3], c1);
 }
 
 /// The row-add update of one difference vector: advance one step.
@@ -377,12 +405,14 @@ class PatchStepper {
 /// Steps a prepared patch whose table needs the 128-bit accumulator with a
 /// 64-bit inner loop (docs/precision.md, "Per-line rounding"): the outer
 /// direction is stepped in the wide format, and at each line its difference
-/// vector is rounded once to the line's own format (s_line_frac_bits or
+/// vector is rounded to the line's own format (s_line_frac_bits or
 /// t_line_frac_bits, which must be non-zero for the family stepped), the
-/// rounding half added to its position, and stepped in int64_t. Every point
-/// is within 0.51 quanta of the exact patch; s-lines and t-lines may differ
-/// by a quantum where the exact value is within about 0.002 quanta of a half
-/// (they round different lines).
+/// rounding half added to its position, and stepped in int64_t; a line
+/// longer than its family's segment steps is re-rounded at the start of each
+/// segment from its exact wide state. Every point is within 0.51 quanta of
+/// the exact patch; s-lines and t-lines may differ by a quantum where the
+/// exact value is within about 0.005 quanta of a half (they round different
+/// lines).
 template <int kDims>
 class LinePatchStepper {
  public:
@@ -393,24 +423,13 @@ class LinePatchStepper {
   void ForEachSLinePoint(Sink&& sink) const {
     Int128 dd[kDims][4][4];
     Copy(dd);
-    const int line_bits = patch_.s_line_frac_bits;
-    const int shift = patch_.format.frac_bits - line_bits;
-    // The rounding half rides in each line's position (the planner left 2
-    // quanta of range for it), so a point is a shift, or the high word.
-    const int64_t half = int64_t{1} << (line_bits - 1);
-    int64_t line[kDims][4];
-    int32_t point[kDims];
     for (uint32_t i = 0;; ++i) {
+      Int128 line[kDims][4];
       for (int c = 0; c < kDims; ++c) {
-        for (int l = 0; l < 4; ++l) line[c][l] = internal::RoundToLine(dd[c][0][l], shift);
-        line[c][0] += half;
+        for (int l = 0; l < 4; ++l) line[c][l] = dd[c][0][l];
       }
-      for (uint32_t j = 0;; ++j) {
-        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
-        sink(i, j, point);
-        if (j == patch_.steps_t) break;
-        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
-      }
+      StepLine(line, patch_.s_line_frac_bits, patch_.s_line_segment_steps, patch_.steps_t,
+               [&](uint32_t j, const int32_t(&point)[kDims]) { sink(i, j, point); });
       if (i == patch_.steps_s) break;
       for (int c = 0; c < kDims; ++c) {
         for (int l = 0; l < 4; ++l) {
@@ -427,24 +446,13 @@ class LinePatchStepper {
   void ForEachTLinePoint(Sink&& sink) const {
     Int128 dd[kDims][4][4];
     Copy(dd);
-    const int line_bits = patch_.t_line_frac_bits;
-    const int shift = patch_.format.frac_bits - line_bits;
-    // The rounding half rides in each line's position (the planner left 2
-    // quanta of range for it), so a point is a shift, or the high word.
-    const int64_t half = int64_t{1} << (line_bits - 1);
-    int64_t line[kDims][4];
-    int32_t point[kDims];
     for (uint32_t j = 0;; ++j) {
+      Int128 line[kDims][4];
       for (int c = 0; c < kDims; ++c) {
-        for (int k = 0; k < 4; ++k) line[c][k] = internal::RoundToLine(dd[c][k][0], shift);
-        line[c][0] += half;
+        for (int k = 0; k < 4; ++k) line[c][k] = dd[c][k][0];
       }
-      for (uint32_t i = 0;; ++i) {
-        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
-        sink(i, j, point);
-        if (i == patch_.steps_s) break;
-        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
-      }
+      StepLine(line, patch_.t_line_frac_bits, patch_.t_line_segment_steps, patch_.steps_s,
+               [&](uint32_t i, const int32_t(&point)[kDims]) { sink(i, j, point); });
       if (j == patch_.steps_t) break;
       for (int c = 0; c < kDims; ++c) {
         for (int k = 0; k < 4; ++k) internal::Step(dd[c][k]);
@@ -453,6 +461,43 @@ class LinePatchStepper {
   }
 
  private:
+  /// Steps one line of `steps` steps from `wide`, its difference vectors in
+  /// the table's format, segment by segment: each segment's vectors are
+  /// rounded to `line_bits` fractional bits with the rounding half added to
+  /// the position (the planner left 2 quanta of range for it), so that a
+  /// point is a floor shift or the high word, and stepped in int64_t; then
+  /// `wide` is advanced exactly to the next segment's start. Calls
+  /// line_sink(index along the line, point) for indices 0..steps.
+  template <typename LineSink>
+  void StepLine(Int128 (&wide)[kDims][4], int line_bits, uint16_t segment_steps, uint16_t steps,
+                LineSink&& line_sink) const {
+    const int shift = patch_.format.frac_bits - line_bits;
+    int64_t half;
+    internal::RoundingHalf(line_bits, &half);
+    int64_t line[kDims][4];
+    int32_t point[kDims];
+    for (uint32_t start = 0;;) {
+      const bool last_segment = steps - start <= segment_steps;
+      const uint32_t end = last_segment ? steps : start + segment_steps;
+      for (int c = 0; c < kDims; ++c) {
+        for (int k = 0; k < 4; ++k) line[c][k] = internal::RoundToLine(wide[c][k], shift);
+        line[c][0] += half;
+      }
+      // A segment's last point is the next segment's first: only the last
+      // segment emits its end.
+      const uint32_t last_point = last_segment ? end : end - 1;
+      for (uint32_t n = start;; ++n) {
+        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
+        line_sink(n, point);
+        if (n == last_point) break;
+        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      }
+      if (last_segment) return;
+      for (int c = 0; c < kDims; ++c) internal::AdvanceExactly(wide[c], end - start);
+      start = end;
+    }
+  }
+
   void Copy(Int128 (&to)[kDims][4][4]) const {
     for (int c = 0; c < kDims; ++c) {
       for (int k = 0; k < 4; ++k) {

@@ -54,6 +54,14 @@ struct Int128 {
 
 namespace internal {
 
+/// value · factor modulo 2^128: the exact product whenever it fits, as the
+/// sum of a wrapping stepper would be (intermediate sums may wrap).
+inline Int128 MultipliedBy(const Int128& value, uint32_t factor) {
+  const uint64_t low = (value.lo & 0xFFFFFFFFu) * factor;
+  const uint64_t middle = (value.lo >> 32) * factor + (low >> 32);  // < 2^64
+  return Int128{(middle << 32) | (low & 0xFFFFFFFFu), value.hi * factor + (middle >> 32)};
+}
+
 /// Two's complement reinterpretation, well defined for every value.
 inline int32_t ToInt32(uint32_t bits) {
   return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits) : -static_cast<int32_t>(~bits) - 1;
