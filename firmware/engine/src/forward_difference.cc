@@ -380,7 +380,10 @@ Status Prepare(const int64_t (&g)[kDims][4][4], Basis basis, const Axis& s, cons
   format->word_aligned = word_aligned ? 1 : 0;
   *exact = all_exact;
   if (line_formats != nullptr) {
-    const bool lines = acc_bits == 128 && t.size == 4;
+    // Lines for every patch table whose own points are not already the
+    // high word: the 128-bit ones, and the 64-bit ones with more than 32
+    // fractional bits (grids from 26×26 on), whose lines get 32.
+    const bool lines = t.size == 4 && (acc_bits == 128 || frac_bits > 32);
     for (int family = 0; family < 2; ++family) {
       (*line_formats)[family] =
           lines ? PlanLineFormat(planes, s, t, denominator, family == 0, frac_bits, options)

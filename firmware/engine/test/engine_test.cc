@@ -337,10 +337,18 @@ TEST(PatchEngine, ChoosesTheNarrowestAccumulator) {
   ASSERT_EQ(Prepare(patch, Basis::kBezier, 64, 64, &prepared), Status::kOk);
   EXPECT_EQ(prepared.format.acc_bits, 64);
   EXPECT_EQ(prepared.format.frac_bits, RequiredFracBits(64, 64));
-  EXPECT_EQ(prepared.s_line_frac_bits, 0);  // no per-line rounding for a 64-bit table
-  EXPECT_EQ(prepared.t_line_frac_bits, 0);
+  // F = 40 > 32: its lines get 32 bits (a point is the high word), in one
+  // segment each.
+  EXPECT_EQ(prepared.s_line_frac_bits, 32);
+  EXPECT_EQ(prepared.t_line_frac_bits, 32);
+  EXPECT_EQ(prepared.s_line_segment_steps, 64);
   ASSERT_EQ(Prepare(patch, Basis::kBezier, 1024, 1024, &prepared), Status::kOk);
   EXPECT_EQ(prepared.format.acc_bits, 128);
+  // A word-aligned table's own points are the high word already: no lines.
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 16, 16, &prepared), Status::kOk);
+  EXPECT_EQ(prepared.format.word_aligned, 1);
+  EXPECT_EQ(prepared.s_line_frac_bits, 0);
+  EXPECT_EQ(prepared.t_line_frac_bits, 0);
 }
 
 // Word-aligned stepping (docs/precision.md): a 64-bit table with F <= 32

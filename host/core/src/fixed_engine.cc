@@ -96,15 +96,12 @@ double ErrorBoundBeforeRounding(const PreparedPatch<3>& patch, Basis basis) {
   // of its format, propagated over the steps of one segment (a line is
   // re-rounded from its exact state at every segment's start).
   double line = 0;
-  if (patch.format.acc_bits != 64) {
-    if (patch.s_line_frac_bits != 0) {
-      line =
-          propagation(patch.s_line_segment_steps) * std::ldexp(1.0, -(patch.s_line_frac_bits + 1));
-    }
-    if (patch.t_line_frac_bits != 0) {
-      line = std::max(line, propagation(patch.t_line_segment_steps) *
-                                std::ldexp(1.0, -(patch.t_line_frac_bits + 1)));
-    }
+  if (patch.s_line_frac_bits != 0) {
+    line = propagation(patch.s_line_segment_steps) * std::ldexp(1.0, -(patch.s_line_frac_bits + 1));
+  }
+  if (patch.t_line_frac_bits != 0) {
+    line = std::max(line, propagation(patch.t_line_segment_steps) *
+                              std::ldexp(1.0, -(patch.t_line_frac_bits + 1)));
   }
   const double conversion = LebesgueConstant(basis) * (std::ldexp(1.0, -17) + std::ldexp(1.0, -20));
   return stepping + line + conversion;

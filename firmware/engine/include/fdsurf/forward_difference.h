@@ -95,10 +95,11 @@ struct PreparedPatch {
   uint16_t steps_t;
   bool exact;
   /// Per-line rounding (docs/precision.md, "Per-line rounding"), planned
-  /// only when `format` needs the 128-bit accumulator: the fractional bits
-  /// of the 64-bit line stepper of LinePatchStepper along s-lines (stepping
-  /// t) and along t-lines (stepping s); 0 when such a line does not fit 64
-  /// bits, or when `format` is 64-bit already.
+  /// when `format` needs the 128-bit accumulator or has more than 32
+  /// fractional bits: the fractional bits of the 64-bit line stepper of
+  /// LinePatchStepper along s-lines (stepping t) and along t-lines (stepping
+  /// s); 0 when such a line does not fit 64 bits, or for a table with 32
+  /// fractional bits or fewer (its own stepper is as fast).
   uint8_t s_line_frac_bits;
   uint8_t t_line_frac_bits;
   /// Under per-line rounding, the most steps a line is stepped in 64 bits
@@ -402,8 +403,9 @@ class PatchStepper {
   uint16_t steps_t_;
 };
 
-/// Steps a prepared patch whose table needs the 128-bit accumulator with a
-/// 64-bit inner loop (docs/precision.md, "Per-line rounding"): the outer
+/// Steps a prepared patch with per-line rounding, a 64-bit inner loop whose
+/// points are the high word wherever the plan gives the lines 32 bits
+/// (docs/precision.md, "Per-line rounding"): the outer
 /// direction is stepped in the wide format, and at each line its difference
 /// vector is rounded to the line's own format (s_line_frac_bits or
 /// t_line_frac_bits, which must be non-zero for the family stepped), the

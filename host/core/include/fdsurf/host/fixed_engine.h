@@ -22,15 +22,16 @@ PreparedPatch<3> PrepareFixedPatch(const Patch& patch, const Quantum& quantum, i
                                    int steps_t, const PrepareOptions& options = {});
 
 /// Steps a prepared patch along s-lines (the grid, i-major) with a 64-bit
-/// inner loop where the plan allows it: the table's own accumulator when it
-/// is 64-bit, else the per-line rounding (LinePatchStepper) when the lines
-/// fit 64 bits, else the 128-bit accumulator. sink(i, j, const int32_t (&)[3]).
+/// inner loop where the plan allows it: the per-line rounding
+/// (LinePatchStepper) where the plan has the lines' format (every table
+/// with more than 32 fractional bits whose lines fit 64 bits), else the
+/// table's own accumulator. sink(i, j, const int32_t (&)[3]).
 template <typename Sink>
 void ForEachGridPoint(const PreparedPatch<3>& patch, Sink&& sink) {
-  if (patch.format.acc_bits == 64) {
-    PatchStepper<std::int64_t, 3>(patch).ForEachSLinePoint(sink);
-  } else if (patch.s_line_frac_bits != 0) {
+  if (patch.s_line_frac_bits != 0) {
     LinePatchStepper<3>(patch).ForEachSLinePoint(sink);
+  } else if (patch.format.acc_bits == 64) {
+    PatchStepper<std::int64_t, 3>(patch).ForEachSLinePoint(sink);
   } else {
     PatchStepper<Int128, 3>(patch).ForEachSLinePoint(sink);
   }
@@ -39,10 +40,10 @@ void ForEachGridPoint(const PreparedPatch<3>& patch, Sink&& sink) {
 /// As above along t-lines.
 template <typename Sink>
 void ForEachTLinePoint(const PreparedPatch<3>& patch, Sink&& sink) {
-  if (patch.format.acc_bits == 64) {
-    PatchStepper<std::int64_t, 3>(patch).ForEachTLinePoint(sink);
-  } else if (patch.t_line_frac_bits != 0) {
+  if (patch.t_line_frac_bits != 0) {
     LinePatchStepper<3>(patch).ForEachTLinePoint(sink);
+  } else if (patch.format.acc_bits == 64) {
+    PatchStepper<std::int64_t, 3>(patch).ForEachTLinePoint(sink);
   } else {
     PatchStepper<Int128, 3>(patch).ForEachTLinePoint(sink);
   }
