@@ -278,12 +278,13 @@ bool AllLinesFit(const Plane (&planes)[kDims], const Axis& s, const Axis& t, con
 }
 
 // The line format of one family (0: none): planned for a table in the
-// 128-bit format, if every coordinate's line fits 64 bits with fewer
-// fractional bits than the table's. Where the range allows, the line gets
-// exactly 32 bits, so that a point is its position's high word (the
-// word-aligned stepping of docs/precision.md): a line whose derivation asks
-// for 32 bits or fewer keeps them all along (more bits only shrink its
-// error); a longer one (more than 369 steps) is cut into segments that need
+// 128-bit format or a 64-bit one with more than 32 fractional bits, if every
+// coordinate's line fits 64 bits with fewer fractional bits than the
+// table's. Where the range allows, the line gets exactly 32 bits, so that a
+// point is its position's high word (the word-aligned stepping of
+// docs/precision.md): a line whose derivation asks for 32 bits or fewer
+// keeps them all along (more bits only shrink its error); a longer one
+// (more than 586 steps) is cut into segments that need
 // 32 bits or fewer (LineSegmentSteps), each rounded from the line's exact
 // wide state at its start, so that its error term is a segment's. Else the
 // line gets the derivation's bits and is rounded once.

@@ -494,6 +494,29 @@ TEST(PatchEngine, AdvanceExactlyIsThatManySteps) {
   }
 }
 
+// A table built by hand with no segment length (0) steps each line whole:
+// at 256 steps, one segment by plan, the points are the planned ones.
+TEST(PatchEngine, NoSegmentLengthStepsWholeLines) {
+  std::mt19937_64 rng(29);
+  const RawPatch patch = RandomPatch(rng, Basis::kBezier, 1 << 17);
+  PreparedPatch<3> planned;
+  ASSERT_EQ(Prepare(patch, Basis::kBezier, 256, 256, &planned), Status::kOk);
+  ASSERT_EQ(planned.s_line_segment_steps, 256);
+  PreparedPatch<3> by_hand = planned;
+  by_hand.s_line_segment_steps = 0;
+  std::vector<std::int32_t> expected;
+  std::vector<std::int32_t> actual;
+  const auto into = [](std::vector<std::int32_t>* out) {
+    return [out](std::uint32_t, std::uint32_t, const std::int32_t(&p)[3]) {
+      out->insert(out->end(), p, p + 3);
+    };
+  };
+  LinePatchStepper<3>(planned).ForEachSLinePoint(into(&expected));
+  LinePatchStepper<3>(by_hand).ForEachSLinePoint(into(&actual));
+  EXPECT_EQ(actual.size(), 3u * 257 * 257);
+  EXPECT_TRUE(actual == expected);
+}
+
 TEST(PrecisionPlanner, RequiredFracBitsMatchTheDerivation) {
   // S(n) = Σ_{k≤3} C(n,k); F = bitlength(S(n)·S(m)) + 9 (docs/precision.md).
   const auto s = [](std::uint64_t n) {

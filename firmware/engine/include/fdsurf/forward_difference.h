@@ -124,7 +124,7 @@ int RequiredLineFracBits(uint32_t steps);
 /// The segment length of a line of `steps` steps under per-line rounding
 /// with 32-bit lines: `steps` when RequiredLineFracBits(steps) ≤ 32, else
 /// ceil(steps / k) for the smallest number of segments k whose length
-/// needs 32 bits or fewer (1024 steps: 3 segments of at most 342).
+/// needs 32 bits or fewer (up to 586 steps: one; 1024 steps: 2 of 512).
 uint16_t LineSegmentSteps(uint16_t steps);
 
 /// Plans and sets up one curve coordinate by coordinate.
@@ -474,13 +474,15 @@ class LinePatchStepper {
   void StepLine(Int128 (&wide)[kDims][4], int line_bits, uint16_t segment_steps, uint16_t steps,
                 LineSink&& line_sink) const {
     const int shift = patch_.format.frac_bits - line_bits;
+    // 0 (a table built by hand without segments): the whole line at once.
+    const uint32_t segment = segment_steps == 0 ? steps : segment_steps;
     int64_t half;
     internal::RoundingHalf(line_bits, &half);
     int64_t line[kDims][4];
     int32_t point[kDims];
     for (uint32_t start = 0;;) {
-      const bool last_segment = steps - start <= segment_steps;
-      const uint32_t end = last_segment ? steps : start + segment_steps;
+      const bool last_segment = steps - start <= segment;
+      const uint32_t end = last_segment ? steps : start + segment;
       for (int c = 0; c < kDims; ++c) {
         for (int k = 0; k < 4; ++k) line[c][k] = internal::RoundToLine(wide[c][k], shift);
         line[c][0] += half;
