@@ -200,8 +200,9 @@ TEST_F(GpioServe, StoppingTheServerMidJobLeavesThePenUpAndTheDriversOff) {
   // position from its status replies), not after a fixed time: under the
   // sanitizers on a loaded machine the client took more than 1.5 s to start.
   const auto deadline = Clock::now() + std::chrono::seconds(20);
-  while (Slurp(journal).find("position 0 0 0") != std::string::npos ||
-         Slurp(journal).find("position ") == std::string::npos) {
+  for (std::string text = Slurp(journal); text.find("position ") == std::string::npos ||
+                                          text.find("position 0 0 0") != std::string::npos;
+       text = Slurp(journal)) {
     ASSERT_LT(Clock::now(), deadline)
         << "the carriage did not move within 20 s: " << Slurp(dir_ / "bg.err");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -225,17 +225,32 @@ Status BuildPlane(const int64_t (&g)[4][4], const Axis& s, const Axis& t, Plane*
   return Status::kOk;
 }
 
+// A bound on a difference, plus `margin` quanta, stays below 2^headroom
+// quanta: bound/D + margin < 2^headroom, checked exactly as
+// bound + margin·D < D·2^headroom. The one form of every range check below;
+// built once per check, then applied to each bound.
+class QuantaLimit {
+ public:
+  QuantaLimit(const Denominator& d, int headroom, int64_t margin)
+      : limit_(d.value.ShiftedLeft(headroom)), margin_d_(d.value) {
+    // margin is 1 or 2: additions, not a wide product
+    for (int64_t i = 1; i < margin; ++i) margin_d_ += d.value;
+  }
+  FDSURF_NODISCARD bool Admits(const Wide& bound) const { return bound + margin_d_ < limit_; }
+
+ private:
+  Wide limit_;
+  Wide margin_d_;
+};
+
 // Every difference of the table, plus `margin` quanta, stays below
-// 2^headroom quanta: bound/D + margin < 2^headroom, checked exactly as
-// bound + margin·D < D·2^headroom.
+// 2^headroom quanta.
 bool TableBelow(const Plane& plane, const Axis& s, const Axis& t, const Denominator& d,
                 int headroom, int64_t margin) {
-  const Wide limit = d.value.ShiftedLeft(headroom);
-  Wide margin_d = d.value;  // margin is 1 or 2: additions, not a wide product
-  for (int64_t i = 1; i < margin; ++i) margin_d += d.value;
+  const QuantaLimit below(d, headroom, margin);
   for (int k = 0; k < s.size; ++k) {
     for (int l = 0; l < t.size; ++l) {
-      if (!(plane.bound[k][l] + margin_d < limit)) return false;
+      if (!below.Admits(plane.bound[k][l])) return false;
     }
   }
   return true;
@@ -258,12 +273,10 @@ bool FitsLine(const Plane& plane, const Axis& s, const Axis& t, const Denominato
               int frac_bits) {
   const int headroom = 63 - frac_bits;
   if (headroom < 1) return false;
-  const Wide limit = d.value.ShiftedLeft(headroom);
-  const Wide margin = d.value + d.value;
+  const QuantaLimit below(d, headroom, 2);
   const int entries = s_lines ? t.size : s.size;
   for (int e = 0; e < entries; ++e) {
-    const Wide& bound = s_lines ? plane.bound[0][e] : plane.bound[e][0];
-    if (!(bound + margin < limit)) return false;
+    if (!below.Admits(s_lines ? plane.bound[0][e] : plane.bound[e][0])) return false;
   }
   return true;
 }
@@ -319,7 +332,7 @@ bool FitsWordAligned(const Plane& plane, const Axis& s, const Axis& t, const Den
 
 // Positions themselves (plus a quantum) must fit the int32_t output.
 bool FitsOutput(const Plane& plane, const Denominator& d) {
-  return plane.bound[0][0] + d.value < d.value.ShiftedLeft(31);
+  return QuantaLimit(d, 31, 1).Admits(plane.bound[0][0]);
 }
 
 template <int kDims>
