@@ -204,14 +204,6 @@ inline int64_t RoundToLine(const Int128& value, int shift) {
   return static_cast<int64_t>(ShiftRightArithmetic(biased, shift).lo);
 }
 
-/// A line's position with the rounding half already added (LinePatchStepper),
-/// as whole quanta: floor(position·2^-frac_bits), the high word when the line
-/// has 32 fractional bits.
-inline int32_t LinePointQuanta(const int64_t& position, int frac_bits) {
-  if (frac_bits == 32) return PositionQuanta(position, true, 32);
-  return FloorToQuanta(position, frac_bits);
-}
-
 /// Advances a difference vector `steps` steps at once, exactly: Δ^k after
 /// the steps is Σ_b C(steps, b)·Δ^(k+b), the closed form of that many
 /// row-add updates (Pascal's rule), so the result is what stepping would
@@ -267,6 +259,189 @@ __attribute__((noinline)) inline void Step(int64_t* d) {
 }
 #endif
 
+/// One coordinate's difference vector in a word-aligned 64-bit stepper
+/// (WordAlignedLanes): Load, Step (the row-add update; `third` is the
+/// coordinate's third difference in the stepper's table, the same at every
+/// step of a cubic) and Quanta (the position's high word, as
+/// PositionQuanta). Per core, because the compiler's own code is far from
+/// the instruction count the core allows (docs/performance.md, "Stepping
+/// in lanes"):
+/// - generic (Thumb-2, x86-64, ...): d0..d2 as int64_t locals the compiler
+///   keeps in registers; the third difference is read from the table at each
+///   step, which leaves two registers a coordinate free (2-D on the
+///   Cortex-M4F: 26 instructions a point, 57 with arrays);
+/// - RV32, which has no carry flag: written out in 32-bit halves;
+/// - ARMv6-M (Cortex-M0), whose adds take only the 8 low registers: in
+///   memory, one ldm and two stm a step;
+/// - AVR: in memory, internal::Step's add-with-carry chain.
+#if defined(__riscv) && __riscv_xlen == 32
+/// Each entry as two 32-bit halves in registers. A 64-bit add is four
+/// instructions in place: add the low words, carry = sum < addend, add the
+/// high words, add the carry. GCC's own keeps each old low word alive for its
+/// carry test and adds a move per add (a probe: 38 instructions a 2-D point;
+/// 29.3 measured with this).
+struct WordAlignedLane {
+  uint32_t lo[4];
+  uint32_t hi[4];
+
+  void Load(const int64_t (&from)[4]) {
+    for (int k = 0; k < 4; ++k) {
+      lo[k] = static_cast<uint32_t>(static_cast<uint64_t>(from[k]));
+      hi[k] = static_cast<uint32_t>(static_cast<uint64_t>(from[k]) >> 32);
+    }
+  }
+  void Step(const int64_t& /*third: held in lo[3], hi[3]*/) {
+    uint32_t carry;
+    asm("add %[l0], %[l0], %[l1]\n\t"
+        "sltu %[c], %[l0], %[l1]\n\t"
+        "add %[h0], %[h0], %[h1]\n\t"
+        "add %[h0], %[h0], %[c]\n\t"
+        "add %[l1], %[l1], %[l2]\n\t"
+        "sltu %[c], %[l1], %[l2]\n\t"
+        "add %[h1], %[h1], %[h2]\n\t"
+        "add %[h1], %[h1], %[c]\n\t"
+        "add %[l2], %[l2], %[l3]\n\t"
+        "sltu %[c], %[l2], %[l3]\n\t"
+        "add %[h2], %[h2], %[h3]\n\t"
+        "add %[h2], %[h2], %[c]"
+        : [l0] "+r"(lo[0]), [h0] "+r"(hi[0]), [l1] "+r"(lo[1]), [h1] "+r"(hi[1]), [l2] "+r"(lo[2]),
+          [h2] "+r"(hi[2]), [c] "=&r"(carry)
+        : [l3] "r"(lo[3]), [h3] "r"(hi[3]));
+  }
+  FDSURF_NODISCARD int32_t Quanta() const { return ToInt32(hi[0]); }
+};
+#elif defined(__ARM_ARCH_6M__) || defined(__AVR__)
+struct WordAlignedLane {
+  int64_t d[4];
+
+  void Load(const int64_t (&from)[4]) {
+    for (int k = 0; k < 4; ++k) d[k] = from[k];
+  }
+#if defined(__AVR__)
+  void Step(const int64_t& /*third: d[3]*/) { internal::Step(d); }
+#else
+  /// The 8 words of a lane do not fit the 8 low registers beside a pointer,
+  /// so the lane stays in memory: one ldm loads d0..d2 into r0-r5, d0 += d1
+  /// and d1 += d2 run there, one stm stores d0 and d1, which frees r0 and r1
+  /// for d3, and d2 += d3 is stored with a second stm: 12 instructions a
+  /// coordinate, where GCC's version moves every word through the stack (a
+  /// probe: 49 instructions a 2-D point; 35.7 measured with this). The
+  /// pointer takes a seventh low
+  /// register, so the block builds with a frame pointer (r7) too, and the
+  /// eighth is left to the caller's loop counter.
+  void Step(const int64_t& /*third: d[3]*/) {
+    int64_t* at = d;
+    // GCC passes Thumb-1 inline assembly in the divided syntax; this block
+    // is written in the unified one and switches back at its end.
+    asm volatile(
+        ".syntax unified\n\t"
+        "ldm %[at]!, {r0, r1, r2, r3, r4, r5}\n\t"
+        "adds r0, r0, r2\n\t"
+        "adcs r1, r1, r3\n\t"
+        "adds r2, r2, r4\n\t"
+        "adcs r3, r3, r5\n\t"
+        "subs %[at], %[at], #24\n\t"
+        "stm %[at]!, {r0, r1, r2, r3}\n\t"
+        "ldr r0, [%[at], #8]\n\t"
+        "ldr r1, [%[at], #12]\n\t"
+        "adds r4, r4, r0\n\t"
+        "adcs r5, r5, r1\n\t"
+        "stm %[at]!, {r4, r5}\n\t"
+        ".syntax divided"
+        : [at] "+l"(at)
+        :
+        : "r0", "r1", "r2", "r3", "r4", "r5", "cc", "memory");
+  }
+#endif
+  FDSURF_NODISCARD int32_t Quanta() const { return PositionQuanta(d[0], true, 32); }
+};
+#else
+struct WordAlignedLane {
+  int64_t d[3];
+
+  void Load(const int64_t (&from)[4]) {
+    for (int k = 0; k < 3; ++k) d[k] = from[k];
+  }
+  void Step(const int64_t& third) {
+    d[0] += d[1];
+    d[1] += d[2];
+    d[2] += third;
+  }
+  FDSURF_NODISCARD int32_t Quanta() const { return PositionQuanta(d[0], true, 32); }
+};
+#endif
+
+/// The difference vectors of a word-aligned 64-bit stepper, one lane per
+/// coordinate as a member rather than an array indexed by a loop over the
+/// coordinates, so that every entry is a named local the compiler can hold
+/// in a register (an array stays in memory and is read and written at every
+/// step). Built by recursion on kDims, so C++14 suffices. `table` is the
+/// difference vectors the lanes were loaded from.
+template <int kDims>
+struct WordAlignedLanes {
+  WordAlignedLane first;
+  WordAlignedLanes<kDims - 1> rest;
+
+  void Load(const int64_t (*table)[4]) {
+    first.Load(table[0]);
+    rest.Load(table + 1);
+  }
+  void Step(const int64_t (*table)[4]) {
+    first.Step(table[0][3]);
+    rest.Step(table + 1);
+  }
+  void Read(int32_t* point) const {
+    *point = first.Quanta();
+    rest.Read(point + 1);
+  }
+};
+template <>
+struct WordAlignedLanes<0> {
+  void Load(const int64_t (*)[4]) {}
+  void Step(const int64_t (*)[4]) {}
+  void Read(int32_t*) const {}
+};
+
+/// Steps the difference vectors `d` (one per coordinate) `steps` times,
+/// calling emit(n, point) at n = 0..steps with the point in quanta; `d` is
+/// scratch afterwards. The int64_t overload steps a word-aligned table in
+/// WordAlignedLanes.
+template <typename Acc, int kDims, typename Emit>
+inline void StepVectors(Acc (&d)[kDims][4], uint32_t steps, int frac_bits, Emit&& emit) {
+  int32_t point[kDims];
+  for (uint32_t n = 0;; ++n) {
+    for (int c = 0; c < kDims; ++c) point[c] = PositionQuanta(d[c][0], false, frac_bits);
+    emit(n, point);
+    if (n == steps) return;
+    for (int c = 0; c < kDims; ++c) Step(d[c]);
+  }
+}
+template <int kDims, typename Emit>
+inline void StepVectors(int64_t (&d)[kDims][4], uint32_t steps, bool word_aligned, int frac_bits,
+                        Emit&& emit) {
+  if (!word_aligned) {
+    StepVectors(d, steps, frac_bits, emit);
+    return;
+  }
+  WordAlignedLanes<kDims> lanes;
+  lanes.Load(d);
+  int32_t point[kDims];
+  // Counting the steps left down to 0 keeps one register free where the
+  // sink ignores the index (steps − left is then dead code).
+  for (uint32_t left = steps;; --left) {
+    lanes.Read(point);
+    emit(steps - left, point);
+    if (left == 0) return;
+    lanes.Step(d);
+  }
+}
+/// 128-bit tables are never word-aligned (the planner sets it for 64 only).
+template <int kDims, typename Emit>
+inline void StepVectors(Int128 (&d)[kDims][4], uint32_t steps, bool /*word_aligned*/, int frac_bits,
+                        Emit&& emit) {
+  StepVectors(d, steps, frac_bits, emit);
+}
+
 }  // namespace internal
 
 /// Steps a prepared curve with accumulator Acc (int64_t or Int128; int64_t
@@ -290,15 +465,7 @@ class CurveStepper {
     for (int c = 0; c < kDims; ++c) {
       for (int k = 0; k < 4; ++k) d[c][k] = d_[c][k];
     }
-    int32_t point[kDims];
-    for (uint32_t i = 0;; ++i) {
-      for (int c = 0; c < kDims; ++c) {
-        point[c] = internal::PositionQuanta(d[c][0], word_aligned_, frac_bits_);
-      }
-      sink(i, point);
-      if (i == steps_) break;
-      for (int c = 0; c < kDims; ++c) internal::Step(d[c]);
-    }
+    internal::StepVectors(d, steps_, word_aligned_, frac_bits_, sink);
   }
 
  private:
@@ -335,19 +502,12 @@ class PatchStepper {
     Acc dd[kDims][4][4];
     Copy(dd);
     Acc line[kDims][4];
-    int32_t point[kDims];
     for (uint32_t i = 0;; ++i) {
       for (int c = 0; c < kDims; ++c) {
         for (int l = 0; l < 4; ++l) line[c][l] = dd[c][0][l];
       }
-      for (uint32_t j = 0;; ++j) {
-        for (int c = 0; c < kDims; ++c) {
-          point[c] = internal::PositionQuanta(line[c][0], word_aligned_, frac_bits_);
-        }
-        sink(i, j, point);
-        if (j == steps_t_) break;
-        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
-      }
+      internal::StepVectors(line, steps_t_, word_aligned_, frac_bits_,
+                            [&](uint32_t j, const int32_t(&point)[kDims]) { sink(i, j, point); });
       if (i == steps_s_) break;
       for (int c = 0; c < kDims; ++c) {
         for (int l = 0; l < 4; ++l) {
@@ -367,19 +527,12 @@ class PatchStepper {
     Acc dd[kDims][4][4];
     Copy(dd);
     Acc line[kDims][4];
-    int32_t point[kDims];
     for (uint32_t j = 0;; ++j) {
       for (int c = 0; c < kDims; ++c) {
         for (int k = 0; k < 4; ++k) line[c][k] = dd[c][k][0];
       }
-      for (uint32_t i = 0;; ++i) {
-        for (int c = 0; c < kDims; ++c) {
-          point[c] = internal::PositionQuanta(line[c][0], word_aligned_, frac_bits_);
-        }
-        sink(i, j, point);
-        if (i == steps_s_) break;
-        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
-      }
+      internal::StepVectors(line, steps_s_, word_aligned_, frac_bits_,
+                            [&](uint32_t i, const int32_t(&point)[kDims]) { sink(i, j, point); });
       if (j == steps_t_) break;
       for (int c = 0; c < kDims; ++c) {
         for (int k = 0; k < 4; ++k) internal::Step(dd[c][k]);
@@ -490,11 +643,18 @@ class LinePatchStepper {
       // A segment's last point is the next segment's first: only the last
       // segment emits its end.
       const uint32_t last_point = last_segment ? end : end - 1;
-      for (uint32_t n = start;; ++n) {
-        for (int c = 0; c < kDims; ++c) point[c] = internal::LinePointQuanta(line[c][0], line_bits);
-        line_sink(n, point);
-        if (n == last_point) break;
-        for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+      if (line_bits == 32) {
+        // The point is the high word: the word-aligned lanes.
+        internal::StepVectors(
+            line, last_point - start, true, 32,
+            [&](uint32_t k, const int32_t(&at)[kDims]) { line_sink(start + k, at); });
+      } else {
+        for (uint32_t n = start;; ++n) {
+          for (int c = 0; c < kDims; ++c) point[c] = FloorToQuanta(line[c][0], line_bits);
+          line_sink(n, point);
+          if (n == last_point) break;
+          for (int c = 0; c < kDims; ++c) internal::Step(line[c]);
+        }
       }
       if (last_segment) return;
       for (int c = 0; c < kDims; ++c) internal::AdvanceExactly(wide[c], end - start);
