@@ -20,6 +20,15 @@ const int64_t kInverseSqrtDims256[4] = {0, 256, 181, 147};
 // basis, less for the others) and of the 4 power coefficients (≤ 4·2^-17).
 constexpr int64_t kPreStepAllowance16 = 64;  // 2^-10 quanta
 
+// The chord error each step may have, in 2^-16 quanta: the tolerance per
+// axis (tolerance/√dims) less the output rounding (1/2 quantum) and the
+// errors made before stepping. At most 2^32·256 < 2^40; ≤ 0 when the
+// tolerance cannot be met with whole-quantum output.
+int64_t ChordBudget16(uint32_t tolerance_q8, int dims) {
+  return static_cast<int64_t>(tolerance_q8) * kInverseSqrtDims256[dims] - (int64_t{1} << 15) -
+         kPreStepAllowance16;
+}
+
 uint64_t Magnitude(int64_t v) {
   return v < 0 ? ~static_cast<uint64_t>(v) + 1 : static_cast<uint64_t>(v);
 }
@@ -114,9 +123,7 @@ template <int kDims>
 Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
                             PreparedAdaptiveCurve<kDims>* out) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
-  const int64_t budget16 =
-      static_cast<int64_t>(settings.tolerance_q8) * kInverseSqrtDims256[kDims] -
-      (int64_t{1} << 15) - kPreStepAllowance16;
+  const int64_t budget16 = ChordBudget16(settings.tolerance_q8, kDims);
   if (budget16 <= 0) return Status::kToleranceUnreachable;
   uint64_t m[kDims][4];
   Status status = CoefficientMagnitudes(curve, m);
@@ -154,6 +161,116 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   if (clamp < chord_limit) chord_limit = clamp;
   result.chord_limit = internal::ToInt128(chord_limit);
   result.step_limit = internal::ToInt128(Wide::PowerOfTwo(frac_bits));
+  *out = result;
+  return Status::kOk;
+}
+
+namespace {
+
+// PrepareAdaptiveCurveAtLevel's arithmetic: unsigned values below 2^127 in
+// an Int128, shifted by 0 ≤ bits < 128 (the callers keep the result below
+// 2^127 first).
+Int128 ShiftedUp(uint64_t value, int bits) {
+  if (bits == 0) return Int128{value, 0};
+  if (bits < 64) return internal::ShiftLeft(Int128{value, 0}, bits);
+  return Int128{0, value << (bits - 64)};
+}
+
+// value·2^bits modulo 2^128, for 0 ≤ bits < 128 (two's complement).
+Int128 ShiftedBy(const Int128& value, int bits) {
+  if (bits == 0) return value;
+  if (bits < 64) return internal::ShiftLeft(value, bits);
+  return Int128{0, value.lo << (bits - 64)};
+}
+
+// Whether value < 2^bits, for 0 ≤ bits ≤ 127.
+bool Below(const Int128& value, int bits) {
+  return bits >= 64 ? value.hi < (uint64_t{1} << (bits - 64))
+                    : value.hi == 0 && value.lo < (uint64_t{1} << bits);
+}
+
+// The level's tests, as FinestLevel and AccumulatorBits make them, in
+// Int128 arithmetic. With every coefficient below 2^47 (CoefficientMagnitudes)
+// the sum S = 22|a| + 5|b| + 2|c| + |d| is below 2^52, so 8·S < 2^55 is
+// shifted by 3L ≤ 90 only once it is known to stay below 2^126; then
+// (6|a| + 2|b|)·2^L + 6|a| ≤ 8·S·2^(3L) < 2^126 too, and the chord limit is
+// only formed when it is below 2^126 (else it exceeds every value the curve
+// has, and the test passes). *acc_bits: 64 or 128.
+template <int kDims>
+Status LevelFits(const uint64_t (&m)[kDims][4], int level, int64_t budget16,
+                 const AdaptiveSettings& settings, int* acc_bits) {
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+  const int scale = 3 + 3 * level;  // the chord limit is budget16·8·2^(3L)
+  bool fits64 = frac_bits <= 62 && settings.max_acc_bits >= 64;
+  for (int c = 0; c < kDims; ++c) {
+    const uint64_t eight_sum = 8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3]);
+    if (!Below(Int128{eight_sum, 0}, 126 - 3 * level)) return Status::kPrecisionUnreachable;
+    Int128 bound = ShiftedUp(eight_sum, 3 * level);
+    bound += ShiftedUp(1, frac_bits);
+    if (!Below(bound, 126)) return Status::kPrecisionUnreachable;
+    fits64 = fits64 && Below(bound, 62);
+    const Int128 second = ShiftedUp(6 * m[c][0] + 2 * m[c][1], level) + Int128{6 * m[c][0], 0};
+    const uint64_t budget = static_cast<uint64_t>(budget16);
+    const bool chord_limit_below_second =
+        Below(Int128{budget, 0}, 126 - scale) && !(second <= ShiftedUp(budget, scale));
+    if (chord_limit_below_second) return Status::kPrecisionUnreachable;
+    if (settings.mode == AdaptiveMode::kStepExact &&
+        (uint64_t{1} << (kCoefficientFracBits + level)) < 3 * m[c][0] + 2 * m[c][1] + m[c][2]) {
+      return Status::kPrecisionUnreachable;
+    }
+  }
+  if (fits64) {
+    *acc_bits = 64;
+  } else if (settings.max_acc_bits >= 128) {
+    *acc_bits = 128;
+  } else {
+    return Status::kPrecisionUnreachable;
+  }
+  return Status::kOk;
+}
+
+}  // namespace
+
+template <int kDims>
+Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
+                                   const AdaptiveSettings& settings,
+                                   PreparedAdaptiveCurve<kDims>* out) {
+  static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
+  const int64_t budget16 = ChordBudget16(settings.tolerance_q8, kDims);
+  if (budget16 <= 0) return Status::kToleranceUnreachable;
+  uint64_t m[kDims][4];
+  Status status = CoefficientMagnitudes(curve, m);
+  if (status != Status::kOk) return status;
+  if (level < 0 || level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
+  int acc_bits = 0;
+  status = LevelFits(m, level, budget16, settings, &acc_bits);
+  if (status != Status::kOk) return status;
+
+  PreparedAdaptiveCurve<kDims> result;
+  result.format.acc_bits = static_cast<uint8_t>(acc_bits);
+  result.format.frac_bits = static_cast<uint8_t>(kCoefficientFracBits + 3 * level);
+  result.format.word_aligned = 0;  // The cursor halves and doubles its steps.
+  result.finest_level = static_cast<uint8_t>(level);
+  result.mode = settings.mode;
+  for (int c = 0; c < kDims; ++c) {
+    // As PrepareAdaptiveCurve forms them; every term is below the bound.
+    const Int128 a = internal::Widen(curve[c].c[0]);
+    const Int128 b = internal::Widen(curve[c].c[1]);
+    const Int128 cc = internal::Widen(curve[c].c[2]);
+    const Int128 d = internal::Widen(curve[c].c[3]);
+    const Int128 six_a = internal::ShiftLeft(a, 2) + internal::ShiftLeft(a, 1);
+    result.d[c][0] = ShiftedBy(d, 3 * level);
+    result.d[c][1] = a + ShiftedBy(b, level) + ShiftedBy(cc, 2 * level);
+    result.d[c][2] = six_a + ShiftedBy(b, level + 1);
+    result.d[c][3] = six_a;
+  }
+  // min(budget16·8·2^(3L), 2^(acc_bits − 2)), as PrepareAdaptiveCurve clamps.
+  const int clamp_bits = acc_bits - 2;
+  const uint64_t budget = static_cast<uint64_t>(budget16);
+  const int scale = 3 + 3 * level;
+  const bool below_clamp = clamp_bits > scale && Below(Int128{budget, 0}, clamp_bits - scale);
+  result.chord_limit = below_clamp ? ShiftedUp(budget, scale) : ShiftedUp(1, clamp_bits);
+  result.step_limit = ShiftedUp(1, result.format.frac_bits);
   *out = result;
   return Status::kOk;
 }
@@ -263,6 +380,12 @@ template Status PrepareAdaptiveCurve<2>(const PowerCurve1 (&)[2], const Adaptive
                                         PreparedAdaptiveCurve<2>*);
 template Status PrepareAdaptiveCurve<3>(const PowerCurve1 (&)[3], const AdaptiveSettings&,
                                         PreparedAdaptiveCurve<3>*);
+template Status PrepareAdaptiveCurveAtLevel<1>(const PowerCurve1 (&)[1], int,
+                                               const AdaptiveSettings&, PreparedAdaptiveCurve<1>*);
+template Status PrepareAdaptiveCurveAtLevel<2>(const PowerCurve1 (&)[2], int,
+                                               const AdaptiveSettings&, PreparedAdaptiveCurve<2>*);
+template Status PrepareAdaptiveCurveAtLevel<3>(const PowerCurve1 (&)[3], int,
+                                               const AdaptiveSettings&, PreparedAdaptiveCurve<3>*);
 template Status CurvePowerCoefficients<1>(const CurveGeometry1 (&)[1], Basis, PowerCurve1 (&)[1]);
 template Status CurvePowerCoefficients<2>(const CurveGeometry1 (&)[2], Basis, PowerCurve1 (&)[2]);
 template Status CurvePowerCoefficients<3>(const CurveGeometry1 (&)[3], Basis, PowerCurve1 (&)[3]);

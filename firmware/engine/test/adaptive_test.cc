@@ -272,6 +272,97 @@ TEST(AdaptiveCurve, RefusesWhatItCannotServe) {
   EXPECT_EQ(curve.format.acc_bits, 128);
 }
 
+bool SamePrepared(const PreparedAdaptiveCurve<3>& x, const PreparedAdaptiveCurve<3>& y) {
+  if (x.format.acc_bits != y.format.acc_bits || x.format.frac_bits != y.format.frac_bits ||
+      x.finest_level != y.finest_level || x.mode != y.mode || !(x.chord_limit == y.chord_limit) ||
+      !(x.step_limit == y.step_limit)) {
+    return false;
+  }
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 4; ++k) {
+      if (!(x.d[c][k] == y.d[c][k])) return false;
+    }
+  }
+  return true;
+}
+
+// The host plans, the device checks the level it is given with shifts and
+// additions only: at the planner's level both give the same bits, below it
+// the check refuses (the planner's level is the smallest that passes), and
+// above it the check accepts exactly while the accumulator still holds the
+// values. The curves span 2^2..2^27 quanta, in both modes and at tolerances
+// from the smallest reachable one, so both accumulators and every refusal
+// are met.
+TEST(AdaptiveCurve, ALevelChosenElsewhereIsCheckedAsThePlannerChecksIt) {
+  std::mt19937_64 rng(20261206);
+  const double tolerances[] = {0.875, 1.0, 4.0, 200.0};
+  int planned[2] = {0, 0};  // 64-bit, 128-bit
+  int refused_below = 0;
+  int accepted_above = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double range = std::ldexp(1.0, 2 + trial % 26);
+    const DoubleCubic cubic = RandomCubic(rng, range);
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = static_cast<std::uint32_t>(tolerances[trial % 4] * 256);
+    settings.mode = (trial / 4) % 2 == 0 ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
+    settings.max_acc_bits = (trial / 8) % 3 == 0 ? 64 : 128;
+    PreparedAdaptiveCurve<3> by_planner;
+    const Status planned_status = PrepareAdaptiveCurve(raw, settings, &by_planner);
+    PreparedAdaptiveCurve<3> at_level;
+    if (planned_status != Status::kOk) {
+      // Refused at every level the planner could have chosen.
+      for (int level = 0; level <= kMaxAdaptiveLevel; ++level) {
+        ASSERT_NE(PrepareAdaptiveCurveAtLevel(raw, level, settings, &at_level), Status::kOk)
+            << trial << " level " << level;
+      }
+      continue;
+    }
+    ++planned[by_planner.format.acc_bits == 64 ? 0 : 1];
+    const int level = by_planner.finest_level;
+    ASSERT_EQ(PrepareAdaptiveCurveAtLevel(raw, level, settings, &at_level), Status::kOk) << trial;
+    ASSERT_TRUE(SamePrepared(by_planner, at_level)) << trial;
+    if (level > 0) {
+      ASSERT_EQ(PrepareAdaptiveCurveAtLevel(raw, level - 1, settings, &at_level),
+                Status::kPrecisionUnreachable)
+          << trial;
+      ++refused_below;
+    }
+    // One level finer: the same curve, accepted unless its values outgrow
+    // the accumulators allowed; then its points are the planner's points of
+    // that finer grid, and the path stays within the tolerance.
+    if (PrepareAdaptiveCurveAtLevel(raw, level + 1, settings, &at_level) == Status::kOk) {
+      ++accepted_above;
+      ASSERT_EQ(at_level.finest_level, level + 1);
+      if (range <= 1024) {  // stepped where that is quick
+        const auto points = StepAll(at_level);
+        EXPECT_LE(WorstDeviation(cubic, points, at_level.finest_level), tolerances[trial % 4])
+            << trial;
+      }
+    }
+  }
+  EXPECT_GT(planned[0], 500);
+  EXPECT_GT(planned[1], 300);
+  EXPECT_GT(refused_below, 1000);
+  EXPECT_GT(accepted_above, 1000);
+}
+
+TEST(AdaptiveCurve, ALevelChosenElsewhereIsRefusedOutsideItsRange) {
+  PowerCurve1 raw[3] = {{{1 << 20, 5, 6, 7}}, {{0, 0, 0, 0}}, {{0, 0, 0, 0}}};
+  AdaptiveSettings settings;
+  settings.tolerance_q8 = 256;
+  PreparedAdaptiveCurve<3> curve;
+  EXPECT_EQ(PrepareAdaptiveCurveAtLevel(raw, -1, settings, &curve), Status::kPrecisionUnreachable);
+  EXPECT_EQ(PrepareAdaptiveCurveAtLevel(raw, kMaxAdaptiveLevel + 1, settings, &curve),
+            Status::kPrecisionUnreachable);
+  settings.tolerance_q8 = 222;
+  EXPECT_EQ(PrepareAdaptiveCurveAtLevel(raw, 5, settings, &curve), Status::kToleranceUnreachable);
+  PowerCurve1 huge[3] = {{{std::int64_t{1} << 46, std::int64_t{1} << 46, 0, 0}}, {}, {}};
+  settings.tolerance_q8 = 256;
+  EXPECT_EQ(PrepareAdaptiveCurveAtLevel(huge, 5, settings, &curve), Status::kGeometryOutOfRange);
+}
+
 // Walker coefficients against the exact rational line: for an s-line at
 // s = i/n, coefficient l of t^(3-l) is Σ_r Σ_c w_s[r]·g[r][c]·(dM)[l][c] / (d²n³).
 TEST(IsolineWalker, LineCoefficientsAreTheExactlyRoundedOnes) {

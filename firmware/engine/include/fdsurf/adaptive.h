@@ -90,6 +90,27 @@ template <int kDims>
 Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
                             PreparedAdaptiveCurve<kDims>* out);
 
+/// Sets up a curve whose power coefficients were rounded, and whose finest
+/// level was chosen, elsewhere (the host: "the host computes, the device
+/// adds"), with no wide-integer arithmetic, multiply by a variable or divide:
+/// shifts, additions and comparisons of Int128 values, so that a small device
+/// needs none of the planner's set-up code. It checks, at `level`, the
+/// planner's own conditions (every coefficient in the geometry range, every
+/// step of 2^-level within the chord limit and, in kStepExact, within one
+/// quantum, every value the stepper forms below 2^62 for the 64-bit
+/// accumulator or 2^126 for Int128, within settings.max_acc_bits), then forms
+/// the table by shifts and additions. For every curve PrepareAdaptiveCurve
+/// prepares, this at its finest_level gives the same bits; a level above the
+/// planner's may be accepted too (its step tests only get easier), one below
+/// it is refused. docs/toolpaths.md, "A level chosen by the host".
+/// Errors: kToleranceUnreachable, kGeometryOutOfRange, kPrecisionUnreachable
+/// (level outside 0..kMaxAdaptiveLevel, a step of 2^-level fails a test, or
+/// no allowed accumulator holds the values).
+template <int kDims>
+Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
+                                   const AdaptiveSettings& settings,
+                                   PreparedAdaptiveCurve<kDims>* out);
+
 /// Converts a curve's basis geometry (fdsurf/forward_difference.h) to power
 /// coefficients, rounding each once to 2^-kCoefficientFracBits quanta.
 /// Errors: kInvalidArgument (basis), kGeometryOutOfRange (|g| ≥ 2^31 quanta).

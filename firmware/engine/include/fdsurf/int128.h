@@ -62,6 +62,11 @@ inline Int128 MultipliedBy(const Int128& value, uint32_t factor) {
   return Int128{(middle << 32) | (low & 0xFFFFFFFFu), value.hi * factor + (middle >> 32)};
 }
 
+/// The Int128 of the same value (sign-extended).
+inline Int128 Widen(int64_t value) {
+  return Int128{static_cast<uint64_t>(value), value < 0 ? ~uint64_t{0} : uint64_t{0}};
+}
+
 /// Two's complement reinterpretation, well defined for every value.
 inline int32_t ToInt32(uint32_t bits) {
   return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits) : -static_cast<int32_t>(~bits) - 1;
