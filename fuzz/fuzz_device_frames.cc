@@ -21,6 +21,7 @@
 #include <memory>
 
 #include "device_harness.h"
+#include "fdsurf/adaptive.h"
 
 namespace {
 
@@ -50,7 +51,7 @@ class Session {
   }
 
   void Act() {
-    switch (in_.ConsumeIntegralInRange<int>(0, 10)) {
+    switch (in_.ConsumeIntegralInRange<int>(0, 11)) {
       case 0:
         Hello();
         break;
@@ -78,6 +79,9 @@ class Session {
         break;
       case 9:
         Run(in_.ConsumeIntegralInRange<std::uint32_t>(0, kMaxTicksPerRun));
+        break;
+      case 10:
+        PreparedCurve();
         break;
       default:
         Corrupted();
@@ -260,6 +264,44 @@ class Session {
     for (int a = 0; a < protocol::kMaxAxes; ++a) {
       for (auto& value : curve.geometry[a].g) value = Coordinate(travel_[a]);
     }
+    SendCommand(command);
+  }
+
+  // A PREPARED_CURVE: a Bézier curve's power coefficients, mostly at the
+  // level the planner chooses or one off it (executed, or refused on
+  // arrival), sometimes at any level.
+  void PreparedCurve() {
+    protocol::Command command;
+    command.type = protocol::MessageType::kPreparedCurve;
+    protocol::PreparedCurveCommand& curve = command.body.prepared_curve;
+    curve.dims = Dims();
+    curve.tolerance_q8 = Tolerance();
+    for (int a = 0; a < protocol::kMaxAxes; ++a) {
+      const std::int64_t p0 = Coordinate(travel_[a]).Raw();
+      const std::int64_t p1 = Coordinate(travel_[a]).Raw();
+      const std::int64_t p2 = Coordinate(travel_[a]).Raw();
+      const std::int64_t p3 = Coordinate(travel_[a]).Raw();
+      // Wrapping arithmetic: out-of-range values are for the decoder to refuse.
+      const auto wrap = [](std::uint64_t v) { return static_cast<std::int64_t>(v); };
+      const auto u = [](std::int64_t v) { return static_cast<std::uint64_t>(v); };
+      curve.power[a].c[0] = wrap(u(p3) - u(p0) + 3 * (u(p1) - u(p2)));
+      curve.power[a].c[1] = wrap(3 * (u(p0) - 2 * u(p1) + u(p2)));
+      curve.power[a].c[2] = wrap(3 * (u(p1) - u(p0)));
+      curve.power[a].c[3] = p0;
+    }
+    int level = in_.ConsumeIntegralInRange<int>(0, 24);
+    if (!Rare() && curve.dims == 2) {
+      fdsurf::AdaptiveSettings settings;
+      settings.mode = fdsurf::AdaptiveMode::kStepExact;
+      settings.tolerance_q8 = curve.tolerance_q8;
+      fdsurf::PowerCurve1 power[2] = {curve.power[0], curve.power[1]};
+      fdsurf::PreparedAdaptiveCurve<2> prepared;
+      if (fdsurf::PrepareAdaptiveCurve(power, settings, &prepared) == fdsurf::Status::kOk) {
+        level = prepared.finest_level + in_.ConsumeIntegralInRange<int>(-1, 1);
+      }
+    }
+    curve.level = static_cast<std::uint8_t>(Rare() ? in_.ConsumeIntegral<std::uint8_t>()
+                                                   : std::max(level, 0));
     SendCommand(command);
   }
 

@@ -116,6 +116,21 @@ def main():
         eng_text = "does not fit" if eng is None else f"{eng[0] + eng[1]:,} / {eng[1]}"
         print(f"| {t} | {eng_text} | {step[0] + step[1]:,} | {img[0] + img[1]:,} | "
               f"{img[1] + img[2]:,} | {img[3]} |")
+    print()
+
+    # The whole device firmware (size/device.cc), and the same without the
+    # planner (size/device_prepared.cc: PREPARED_CURVE only).
+    print("### The device firmware, with and without the planner (bytes)\n")
+    print("| target | device: flash / static RAM | without the planner: flash / static RAM "
+          "| the planner's flash |")
+    print("|---|---|---|---|")
+    for t in present:
+        full = sizes.get((t, "device"))
+        lean = sizes.get((t, "device_prepared"))
+        cells = ["does not fit" if x is None else f"{x[0] + x[1]:,} / {x[1] + x[2]:,}"
+                 for x in (full, lean)]
+        saved = "–" if full is None or lean is None else f"{full[0] + full[1] - lean[0] - lean[1]:,}"
+        print(f"| {t} | {cells[0]} | {cells[1]} | {saved} |")
 
 
 main()

@@ -650,7 +650,7 @@ TEST_F(SerialCli, PortsProbeShowsWhatAnswered) {
   ASSERT_NE(line, std::string::npos) << r.out;
   const std::string row = r.out.substr(line, r.out.find('\n', line) - line);
   EXPECT_NE(row.find(" pty "), std::string::npos) << row;
-  EXPECT_NE(row.find("fdsurf protocol 3, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
+  EXPECT_NE(row.find("fdsurf protocol 4, 2 axes, 20000 Hz ticks, queue 8"), std::string::npos)
       << row;
   // The machine's own ports (if any are listed) are shown, not opened.
   std::istringstream rows(r.out);

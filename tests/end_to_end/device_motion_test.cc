@@ -536,6 +536,22 @@ TEST(ValidateCommand, EveryMoveInsideTheLargestTravelIsPlannable) {
     EXPECT_EQ(PrepareAdaptiveCurve(curve3, settings, &prepared3), Status::kOk);
     PowerCurve1 curve2[2] = {line(from, to), line(to, from)};
     EXPECT_EQ(PrepareAdaptiveCurve(curve2, settings, &prepared2), Status::kOk);
+    // Execution sets moves up at StraightMoveLevel without the planner.
+    EXPECT_EQ(motion::StraightMoveLevel(curve2), prepared2.finest_level);
+    PreparedAdaptiveCurve<2> at_level;
+    EXPECT_EQ(
+        PrepareAdaptiveCurveAtLevel(curve2, motion::StraightMoveLevel(curve2), settings, &at_level),
+        Status::kOk);
+  }
+  // The move's level is the planner's for every length, 0 to 2^26 steps.
+  for (int bits = 0; bits <= 42; ++bits) {
+    for (const std::int64_t length :
+         {(std::int64_t{1} << bits) - 1, std::int64_t{1} << bits, (std::int64_t{1} << bits) + 1}) {
+      if (length > t) continue;  // over the cap (refused above)
+      PowerCurve1 curve2[2] = {line(0, length), line(length / 3, 0)};
+      ASSERT_EQ(PrepareAdaptiveCurve(curve2, settings, &prepared2), Status::kOk) << length;
+      EXPECT_EQ(motion::StraightMoveLevel(curve2), prepared2.finest_level) << length;
+    }
   }
   // One step more and the engine refuses: the cap is where it has to be.
   PowerCurve1 longer[2] = {line(t + 65536, 0), line(0, 0)};

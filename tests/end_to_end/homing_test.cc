@@ -121,7 +121,8 @@ class HomingTest : public ::testing::Test {
 };
 
 TEST_F(HomingTest, HomesBothAxesToTheirMinSwitchesAndBacksOff) {
-  EXPECT_EQ(device_.Features(), protocol::kFeatureEndstops);
+  EXPECT_EQ(device_.Features(), protocol::kFeatureEndstops | protocol::kFeaturePlanner |
+                                    protocol::kFeaturePreparedCurves);
   AcceptAll({ConfigCommand(), HomeCommand(0x03, 0, 2000, 10)});
   device_.Fill();
   ASSERT_EQ(device_.Tick(steps_, pen_), hal::IoStatus::kOk);
@@ -263,7 +264,7 @@ TEST_F(HomingTest, AFailingEndstopReadFaultsTheDevice) {
 
 TEST(HomingWithoutEndstops, HomeIsRefusedAndNoFeatureIsReported) {
   device::Device<2, 4, 256> device(kTickHz);
-  EXPECT_EQ(device.Features(), 0);
+  EXPECT_EQ(device.Features(), protocol::kFeaturePlanner | protocol::kFeaturePreparedCurves);
   std::uint8_t detail = 0;
   ASSERT_EQ(device.Accept(ConfigCommand(), &detail), protocol::ErrorCode::kNone);
   EXPECT_EQ(device.Accept(HomeCommand(0x01, 0, 1000, 0), &detail), protocol::ErrorCode::kBadField);
@@ -374,7 +375,8 @@ TEST(SimulatedPlotterHoming, HomesThroughTheLink) {
   const sim::RunResult result = plotter.Run(link, 60'000'000);
   ASSERT_TRUE(result.finished) << result.error;
   ASSERT_TRUE(link.hello().has_value());
-  EXPECT_EQ(link.hello()->features, protocol::kFeatureEndstops);
+  EXPECT_EQ(link.hello()->features, protocol::kFeatureEndstops | protocol::kFeaturePlanner |
+                                        protocol::kFeaturePreparedCurves);
   EXPECT_EQ(plotter.endstops()->real_position(0), 1008);
   EXPECT_EQ(plotter.endstops()->real_position(1), 508);
   ASSERT_TRUE(link.status().has_value());

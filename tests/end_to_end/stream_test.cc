@@ -381,6 +381,64 @@ TEST(SimulatedPlotter, ResumesAfterAnUnplugAndDrawsTheSame) {
   }
 }
 
+// The host plans every line and sends PREPARED_CURVEs (issue 17: "the host
+// computes, the device adds"); the device draws the same unit moves, so the
+// same strokes, point for point, as when it walks the patches itself.
+TEST(SimulatedPlotter, DrawsTheSameWhenTheHostPlansTheLines) {
+  host::StreamJob job = SmallTeapotJob();
+  ASSERT_EQ(job.config.axes, 2);
+  host::PrepareOnHost(&job);
+  ASSERT_EQ(job.labels.size(), job.commands.size());
+  std::size_t prepared = 0;
+  for (const protocol::Command& command : job.commands) {
+    ASSERT_NE(command.type, protocol::MessageType::kPatch);
+    ASSERT_NE(command.type, protocol::MessageType::kCurve);
+    if (command.type == protocol::MessageType::kPreparedCurve) ++prepared;
+  }
+  // 32 patches of 3 + 3 lines, less the 52 shared edges and the poles.
+  EXPECT_GT(prepared, 100u);
+  const Streamed run = Stream(job, PlotterOptions{});
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, job.commands.size());
+  ASSERT_EQ(run.drawn.size(), Baseline().drawn.size());
+  for (std::size_t k = 0; k < run.drawn.size(); ++k) {
+    ASSERT_EQ(run.drawn[k].points, Baseline().drawn[k].points) << "stroke " << k;
+  }
+  EXPECT_EQ(run.pens.size(), Baseline().pens.size());
+}
+
+// The device checks the level it is given: one below the planner's, a curve
+// moved off the travel, or the wrong number of axes is refused on arrival.
+TEST(SimulatedPlotter, RefusesAPreparedCurveThatItsLevelDoesNotServe) {
+  host::StreamJob job = SmallTeapotJob();
+  host::PrepareOnHost(&job);
+  const protocol::Command* found = nullptr;
+  for (const protocol::Command& command : job.commands) {
+    if (command.type == protocol::MessageType::kPreparedCurve &&
+        command.body.prepared_curve.level > 0) {
+      found = &command;
+      break;
+    }
+  }
+  ASSERT_NE(found, nullptr);
+  std::uint8_t detail = 0;
+  EXPECT_EQ(motion::ValidateCommand<2>(*found, job.config, &detail), protocol::ErrorCode::kNone);
+  protocol::Command coarse = *found;
+  --coarse.body.prepared_curve.level;
+  EXPECT_EQ(motion::ValidateCommand<2>(coarse, job.config, &detail),
+            protocol::ErrorCode::kPlannerRefused);
+  EXPECT_EQ(detail, static_cast<std::uint8_t>(Status::kPrecisionUnreachable));
+  protocol::Command off = *found;
+  off.body.prepared_curve.power[1].c[3] -= std::int64_t{job.config.travel_steps[1]} << 16;
+  EXPECT_EQ(motion::ValidateCommand<2>(off, job.config, &detail),
+            protocol::ErrorCode::kOutOfTravel);
+  EXPECT_EQ(detail & 3, 1);
+  protocol::Command three = *found;
+  three.body.prepared_curve.dims = 3;
+  EXPECT_EQ(motion::ValidateCommand<2>(three, job.config, &detail),
+            protocol::ErrorCode::kDimsMismatch);
+}
+
 TEST(SimulatedPlotter, StreamsTheCurvesOfAFileAsChains) {
   // Two Hermite chains (examples/hermite-chain.json): CURVE commands, with a
   // pen lift only between the chains.

@@ -151,7 +151,8 @@ StreamOptions WithSchedule(const StreamOptions& o, const StreamJob& job) {
 // with --dry-run, to the simulated plotter only).
 int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptions& drawing,
                 const MachineOptions& machine) {
-  const StreamJob job = BuildStreamJob(set, drawing, machine, o.units);
+  StreamJob job = BuildStreamJob(set, drawing, machine, o.units);
+  if (o.prepare_on_host) PrepareOnHost(&job);
   try {
     if (o.dry_run) return RunDryRun(o, job);
     const DeviceKind kind = DeviceKindOf(o.device);
@@ -325,6 +326,9 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
                     "run the job through the simulated plotter with these limits and report "
                     "machine time, pen-down and pen-up distance, pen lifts and the page extent; "
                     "nothing is sent to --device");
+  command->add_flag("--prepare-on-host", o->prepare_on_host,
+                    "plan every line on the host and send it as a PREPARED_CURVE (for a device "
+                    "without a planner of its own); the drawing is the same");
   AddJournalOptions(command, o);
   command->add_flag("--no-pause", o->no_pause,
                     "between layers, say that the pen is to be changed but do not wait for Enter");

@@ -92,6 +92,10 @@ struct StreamOptions {
   /// and report machine time, distances, pen lifts and extent; whatever
   /// --device says, nothing is opened (RunDryRun, runners/runner.h).
   bool dry_run = false;
+  /// --prepare-on-host: plan every line here and send PREPARED_CURVEs
+  /// (PrepareOnHost, fdsurf/host/stream.h), for a device without a planner
+  /// of its own; the drawing is the same.
+  bool prepare_on_host = false;
   /// A real device's schedule in machine time for its progress line (set by
   /// RunStream when the progress line shows; nullptr otherwise).
   std::shared_ptr<const MachineSchedule> schedule;

@@ -5,12 +5,14 @@ namespace fdsurf {
 namespace motion {
 namespace {
 
+using internal::Widen;
 using protocol::ErrorCode;
 using protocol::MessageType;
 
 constexpr int64_t kOneStep = int64_t{1} << kCoefficientFracBits;
 constexpr int64_t kHalfStep = kOneStep / 2;
 
+#if FDSURF_DEVICE_PLANNER
 template <int kDims>
 void CopyGeometry(const PatchGeometry1 (&from)[protocol::kMaxAxes], PatchGeometry1 (&to)[kDims]) {
   for (int c = 0; c < kDims; ++c) to[c] = from[c];
@@ -21,32 +23,10 @@ void CopyGeometry(const CurveGeometry1 (&from)[protocol::kMaxAxes], CurveGeometr
   for (int c = 0; c < kDims; ++c) to[c] = from[c];
 }
 
-// Whether line `index` of `lines` in a family is an edge the command says
-// another patch draws.
-bool Skipped(uint8_t skip_lines, IsolineFamily family, uint16_t index, uint16_t lines) {
-  const uint8_t first =
-      family == IsolineFamily::kSLines ? protocol::kSkipFirstSLine : protocol::kSkipFirstTLine;
-  const uint8_t last =
-      family == IsolineFamily::kSLines ? protocol::kSkipLastSLine : protocol::kSkipLastTLine;
-  return (index == 0 && (skip_lines & first) != 0) ||
-         (index + 1u == lines && (skip_lines & last) != 0);
-}
-
-template <int kDims>
-bool IsPoint(const PowerCurve1 (&curve)[kDims]) {
-  for (int c = 0; c < kDims; ++c) {
-    if (curve[c].c[0] != 0 || curve[c].c[1] != 0 || curve[c].c[2] != 0) return false;
-  }
-  return true;
-}
-
+#endif  // FDSURF_DEVICE_PLANNER
 // 3·low and 3·high: a value in [−1/2, T + 1/2) rounds into [0, T].
 constexpr int64_t kLow3 = -3 * kHalfStep;
 int64_t High3(int32_t travel) { return 3 * (static_cast<int64_t>(travel) * kOneStep + kHalfStep); }
-
-Int128 Widen(int64_t v) {
-  return Int128{static_cast<uint64_t>(v), v < 0 ? ~uint64_t{0} : uint64_t{0}};
-}
 
 // The cubic A·s³ + B·s² + C·s + D of one piece [j·2^-k, (j+1)·2^-k] of a
 // line's axis, in the piece's own parameter s ∈ [0, 1], in units of
@@ -175,17 +155,34 @@ bool WithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel, uint
   return true;
 }
 
-// The planner must accept the line, and every point it will emit must lie
-// within the travel.
-template <int kDims>
-ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8,
-                    const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
+// The step-exact settings of every path the device steps.
+AdaptiveSettings StepExactSettings(uint32_t tolerance_q8) {
   AdaptiveSettings settings;
   settings.mode = AdaptiveMode::kStepExact;
   settings.tolerance_q8 = tolerance_q8;
+  return settings;
+}
+
+// Sets up a line the way execution will: by the planner, or, for a
+// PREPARED_CURVE (level ≥ 0), by checking the host's level.
+template <int kDims>
+Status PrepareLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
+                   PreparedAdaptiveCurve<kDims>* prepared) {
+  const AdaptiveSettings settings = StepExactSettings(tolerance_q8);
+#if FDSURF_DEVICE_PLANNER
+  if (host_level < 0) return PrepareAdaptiveCurve(curve, settings, prepared);
+#endif
+  return PrepareAdaptiveCurveAtLevel(curve, host_level, settings, prepared);
+}
+
+// The planner (or, for a prepared curve, the check of the host's level) must
+// accept the line, and every point it will emit must lie within the travel.
+template <int kDims>
+ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
+                    const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
   PreparedAdaptiveCurve<kDims> prepared;
   if (work != nullptr) ++work->lines;
-  const Status status = PrepareAdaptiveCurve(curve, settings, &prepared);
+  const Status status = PrepareLine(curve, tolerance_q8, host_level, &prepared);
   if (status != Status::kOk) {
     *detail = static_cast<uint8_t>(status);
     return ErrorCode::kPlannerRefused;
@@ -194,28 +191,57 @@ ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8,
                                                                 : ErrorCode::kOutOfTravel;
 }
 
+// The curves' checks are out of line on AVR, so that their locals (the
+// coefficients) do not sit in ValidateCommand's frame under a PATCH's deeper
+// validation. The ATmega2560 board must keep 256 bytes of RAM the stack
+// never reaches (boards/mega2560-ramps/README.md); by -fstack-usage the
+// PATCH path's frames here are 34 + 866 + 244 bytes this way, 152 + 866 +
+// 244 with the cases inline (and 1,205 before PREPARED_CURVE).
 template <int kDims>
-ErrorCode CheckFamily(const PatchGeometry1 (&geometry)[kDims], const protocol::PatchCommand& patch,
-                      IsolineFamily family, uint16_t lines, const protocol::MachineConfig& config,
-                      uint8_t* detail, ValidationWork* work) {
-  if (lines == 0) return ErrorCode::kNone;
-  IsolineWalker<kDims> walker;
-  const Status created =
-      IsolineWalker<kDims>::Create(geometry, patch.basis, family, lines, &walker);
-  if (created != Status::kOk) {
-    *detail = static_cast<uint8_t>(created);
-    return ErrorCode::kPlannerRefused;
-  }
-  PowerCurve1 curve[kDims];
-  for (uint16_t index = 0; walker.Next(curve); ++index) {
-    if (IsPoint(curve) || Skipped(patch.skip_lines, family, index, lines)) continue;  // not drawn
-    if ((index & 1u) != 0) ReverseCurve(curve);
-    const ErrorCode error = CheckLine(curve, patch.tolerance_q8, config, detail, work);
-    if (error != ErrorCode::kNone) return error;
-  }
-  return ErrorCode::kNone;
+FDSURF_OUT_OF_LINE_ON_AVR ErrorCode CheckPreparedCurve(const protocol::PreparedCurveCommand& curve,
+                                                       const protocol::MachineConfig& config,
+                                                       uint8_t* detail, ValidationWork* work) {
+  if (curve.dims != kDims) return ErrorCode::kDimsMismatch;
+  PowerCurve1 power[kDims];
+  for (int c = 0; c < kDims; ++c) power[c] = curve.power[c];
+  return CheckLine(power, curve.tolerance_q8, curve.level, config, detail, work);
 }
 
+#if FDSURF_DEVICE_PLANNER
+template <int kDims>
+FDSURF_OUT_OF_LINE_ON_AVR ErrorCode CheckCurve(const protocol::CurveCommand& curve,
+                                               const protocol::MachineConfig& config,
+                                               uint8_t* detail, ValidationWork* work) {
+  if (curve.dims != kDims) return ErrorCode::kDimsMismatch;
+  CurveGeometry1 geometry[kDims];
+  CopyGeometry(curve.geometry, geometry);
+  PowerCurve1 power[kDims];
+  const Status status = CurvePowerCoefficients(geometry, curve.basis, power);
+  if (status != Status::kOk) {
+    *detail = static_cast<uint8_t>(status);
+    return ErrorCode::kPlannerRefused;
+  }
+  return CheckLine(power, curve.tolerance_q8, kPlannerLevel, config, detail, work);
+}
+
+template <int kDims>
+ErrorCode CheckFamily(const protocol::PatchCommand& patch, IsolineFamily family,
+                      const protocol::MachineConfig& config, uint8_t* detail,
+                      ValidationWork* work) {
+  ErrorCode error = ErrorCode::kNone;
+  const Status walked =
+      ForEachDrawnLine<kDims>(patch, family, [&](const PowerCurve1(&curve)[kDims]) {
+        error = CheckLine(curve, patch.tolerance_q8, kPlannerLevel, config, detail, work);
+        return error == ErrorCode::kNone;
+      });
+  if (walked != Status::kOk) {
+    *detail = static_cast<uint8_t>(walked);
+    return ErrorCode::kPlannerRefused;
+  }
+  return error;
+}
+
+#endif  // FDSURF_DEVICE_PLANNER
 }  // namespace
 
 template <int kDims>
@@ -231,6 +257,23 @@ void ReverseCurve(PowerCurve1 (&curve)[kDims]) {
     curve[c].c[2] = -(3 * a + 2 * b + cc);
     curve[c].c[3] = a + b + cc + d;
   }
+}
+
+template <int kDims>
+int StraightMoveLevel(const PowerCurve1 (&line)[kDims]) {
+  uint64_t largest = 0;
+  for (int c = 0; c < kDims; ++c) {
+    const int64_t slope = line[c].c[2];
+    const uint64_t magnitude =
+        slope < 0 ? ~static_cast<uint64_t>(slope) + 1 : static_cast<uint64_t>(slope);
+    if (magnitude > largest) largest = magnitude;
+  }
+  int level = 0;
+  while (level < 63 - kCoefficientFracBits &&
+         (uint64_t{1} << (kCoefficientFracBits + level)) < largest) {
+    ++level;
+  }
+  return level;
 }
 
 template <int kDims>
@@ -266,30 +309,20 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
     return ErrorCode::kOutOfTravel;
   }
   switch (command.type) {
+#if FDSURF_DEVICE_PLANNER
     case MessageType::kPatch: {
       const protocol::PatchCommand& patch = command.body.patch;
       if (patch.dims != kDims) return ErrorCode::kDimsMismatch;
-      PatchGeometry1 geometry[kDims];
-      CopyGeometry(patch.geometry, geometry);
       const ErrorCode s_lines =
-          CheckFamily(geometry, patch, IsolineFamily::kSLines, patch.lines_s, config, detail, work);
+          CheckFamily<kDims>(patch, IsolineFamily::kSLines, config, detail, work);
       if (s_lines != ErrorCode::kNone) return s_lines;
-      return CheckFamily(geometry, patch, IsolineFamily::kTLines, patch.lines_t, config, detail,
-                         work);
+      return CheckFamily<kDims>(patch, IsolineFamily::kTLines, config, detail, work);
     }
-    case MessageType::kCurve: {
-      const protocol::CurveCommand& curve = command.body.curve;
-      if (curve.dims != kDims) return ErrorCode::kDimsMismatch;
-      CurveGeometry1 geometry[kDims];
-      CopyGeometry(curve.geometry, geometry);
-      PowerCurve1 power[kDims];
-      const Status status = CurvePowerCoefficients(geometry, curve.basis, power);
-      if (status != Status::kOk) {
-        *detail = static_cast<uint8_t>(status);
-        return ErrorCode::kPlannerRefused;
-      }
-      return CheckLine(power, curve.tolerance_q8, config, detail, work);
-    }
+    case MessageType::kCurve:
+      return CheckCurve<kDims>(command.body.curve, config, detail, work);
+#endif  // FDSURF_DEVICE_PLANNER
+    case MessageType::kPreparedCurve:
+      return CheckPreparedCurve<kDims>(command.body.prepared_curve, config, detail, work);
     case MessageType::kMove:
       for (int c = 0; c < kDims; ++c) {
         const int32_t target = command.body.move.target[c];
@@ -330,11 +363,9 @@ void PathGenerator<kDims>::Fail(Status status) {
 }
 
 template <int kDims>
-bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8) {
-  AdaptiveSettings settings;
-  settings.mode = AdaptiveMode::kStepExact;
-  settings.tolerance_q8 = tolerance_q8;
-  const Status status = PrepareAdaptiveCurve(curve, settings, &prepared_);
+bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8,
+                                       int host_level) {
+  const Status status = PrepareLine(curve, tolerance_q8, host_level, &prepared_);
   if (status != Status::kOk) {
     Fail(status);
     return false;
@@ -357,7 +388,7 @@ bool PathGenerator<kDims>::StartTravel(const int32_t (&target)[kDims]) {
     line[c].c[2] = (static_cast<int64_t>(target[c]) - position_[c]) * kOneStep;
     line[c].c[3] = static_cast<int64_t>(position_[c]) * kOneStep;
   }
-  return PrepareInto(line, kLineToleranceQ8);
+  return PrepareInto(line, kLineToleranceQ8, StraightMoveLevel(line));
 }
 
 template <int kDims>
@@ -367,9 +398,11 @@ void PathGenerator<kDims>::Start(const protocol::Command& command) {
   pending_count_ = 0;
   pending_head_ = 0;
   switch (command.type) {
+#if FDSURF_DEVICE_PLANNER
     case MessageType::kPatch: {
       patch_ = command.body.patch;
       tolerance_q8_ = patch_.tolerance_q8;
+      host_level_ = kPlannerLevel;
       lift_for_travel_ = true;
       lines_t_ = patch_.lines_t;
       line_index_ = 0;
@@ -395,6 +428,17 @@ void PathGenerator<kDims>::Start(const protocol::Command& command) {
         return;
       }
       tolerance_q8_ = command.body.curve.tolerance_q8;
+      host_level_ = kPlannerLevel;
+      lift_for_travel_ = false;
+      stage_ = Stage::kLineStart;
+      return;
+    }
+#endif  // FDSURF_DEVICE_PLANNER
+    case MessageType::kPreparedCurve: {
+      const protocol::PreparedCurveCommand& curve = command.body.prepared_curve;
+      for (int c = 0; c < kDims; ++c) line_[c] = curve.power[c];
+      tolerance_q8_ = curve.tolerance_q8;
+      host_level_ = curve.level;
       lift_for_travel_ = false;
       stage_ = Stage::kLineStart;
       return;
@@ -468,6 +512,7 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
         *entry = MakeMove(delta, kDims);
         return true;
       }
+#if FDSURF_DEVICE_PLANNER
       case Stage::kPatchNextLine: {
         if (!walker_.Next(line_)) {
           if (family_ == IsolineFamily::kSLines && lines_t_ >= 2) {
@@ -489,11 +534,17 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
         const uint16_t index = line_index_++;
         // A line collapsed to a point (a pole) draws nothing; an edge another
         // patch draws is left to it.
-        if (IsPoint(line_) || Skipped(patch_.skip_lines, family_, index, walker_.lines())) continue;
+        if (IsPoint(line_) || IsSkippedEdge(patch_.skip_lines, family_, index, walker_.lines()))
+          continue;
         if ((index & 1u) != 0) ReverseCurve(line_);
         stage_ = Stage::kLineStart;
         continue;
       }
+#else
+      case Stage::kPatchNextLine:  // no PATCH is accepted without the planner
+        stage_ = Stage::kFinish;
+        continue;
+#endif  // FDSURF_DEVICE_PLANNER
       case Stage::kLineStart: {
         bool there = true;
         for (int c = 0; c < kDims; ++c) {
@@ -519,7 +570,7 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
           pen_down_ = true;
           Emit(MakeEntry(EntryKind::kPenDown));
         }
-        if (!PrepareInto(line_, tolerance_q8_)) return false;
+        if (!PrepareInto(line_, tolerance_q8_, host_level_)) return false;
         after_stepping_ = type_ == MessageType::kPatch ? Stage::kPatchNextLine : Stage::kFinish;
         stage_ = Stage::kStepping;
         continue;
@@ -538,6 +589,8 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
 
 template void ReverseCurve<2>(PowerCurve1 (&)[2]);
 template void ReverseCurve<3>(PowerCurve1 (&)[3]);
+template int StraightMoveLevel<2>(const PowerCurve1 (&)[2]);
+template int StraightMoveLevel<3>(const PowerCurve1 (&)[3]);
 template bool TravelPlannable<2>(const protocol::MachineConfig&, uint8_t*);
 template bool TravelPlannable<3>(const protocol::MachineConfig&, uint8_t*);
 template ErrorCode ValidateCommand<2>(const protocol::Command&, const protocol::MachineConfig&,

@@ -53,6 +53,49 @@ int GeometryAxes(uint8_t dims) { return dims < kMaxAxes ? dims : kMaxAxes; }
 
 uint8_t BoolByte(bool value) { return value ? 1 : 0; }
 
+#if FDSURF_DEVICE_PLANNER
+template <typename Writer>
+void WritePatch(const PatchCommand& p, Writer* w) {
+  w->Put(static_cast<uint8_t>(p.basis));
+  w->Put(p.dims);
+  w->PutU16(p.lines_s);
+  w->PutU16(p.lines_t);
+  w->PutU32(p.tolerance_q8);
+  w->Put(p.skip_lines);
+  for (int a = 0; a < GeometryAxes(p.dims); ++a) {
+    for (const auto& row : p.geometry[a].g) {
+      for (const GeometryFixed value : row) {
+        w->PutSignedVarint(value.Raw());
+      }
+    }
+  }
+}
+
+template <typename Writer>
+void WriteCurve(const CurveCommand& c, Writer* w) {
+  w->Put(static_cast<uint8_t>(c.basis));
+  w->Put(c.dims);
+  w->PutU32(c.tolerance_q8);
+  for (int a = 0; a < GeometryAxes(c.dims); ++a) {
+    for (const GeometryFixed value : c.geometry[a].g) {
+      w->PutSignedVarint(value.Raw());
+    }
+  }
+}
+#endif  // FDSURF_DEVICE_PLANNER
+
+template <typename Writer>
+void WritePreparedCurve(const PreparedCurveCommand& c, Writer* w) {
+  w->Put(c.dims);
+  w->Put(c.level);
+  w->PutU32(c.tolerance_q8);
+  for (int a = 0; a < GeometryAxes(c.dims); ++a) {
+    for (const int64_t coefficient : c.power[a].c) {
+      w->PutSignedVarint(coefficient);
+    }
+  }
+}
+
 template <typename Writer>
 void WriteCommandBody(const Command& command, Writer* w) {
   switch (command.type) {
@@ -77,35 +120,17 @@ void WriteCommandBody(const Command& command, Writer* w) {
       w->Put(c.flags);
       break;
     }
-    case MessageType::kPatch: {
-      const PatchCommand& p = command.body.patch;
-      w->Put(static_cast<uint8_t>(p.basis));
-      w->Put(p.dims);
-      w->PutU16(p.lines_s);
-      w->PutU16(p.lines_t);
-      w->PutU32(p.tolerance_q8);
-      w->Put(p.skip_lines);
-      for (int a = 0; a < GeometryAxes(p.dims); ++a) {
-        for (const auto& row : p.geometry[a].g) {
-          for (const GeometryFixed value : row) {
-            w->PutSignedVarint(value.Raw());
-          }
-        }
-      }
+#if FDSURF_DEVICE_PLANNER
+    case MessageType::kPatch:
+      WritePatch(command.body.patch, w);
       break;
-    }
-    case MessageType::kCurve: {
-      const CurveCommand& c = command.body.curve;
-      w->Put(static_cast<uint8_t>(c.basis));
-      w->Put(c.dims);
-      w->PutU32(c.tolerance_q8);
-      for (int a = 0; a < GeometryAxes(c.dims); ++a) {
-        for (const GeometryFixed value : c.geometry[a].g) {
-          w->PutSignedVarint(value.Raw());
-        }
-      }
+    case MessageType::kCurve:
+      WriteCurve(command.body.curve, w);
       break;
-    }
+#endif
+    case MessageType::kPreparedCurve:
+      WritePreparedCurve(command.body.prepared_curve, w);
+      break;
     case MessageType::kMove:
       for (const int32_t target : command.body.move.target) {
         // A negative target becomes a large varint the decoder refuses.
@@ -235,9 +260,13 @@ class Reader {
 
 constexpr DecodeResult kOk{ErrorCode::kNone, 0};
 
+#if FDSURF_DEVICE_PLANNER
 bool BasisValid(uint8_t basis) { return basis < kBasisCount; }
+#endif
 bool DimsValid(uint8_t dims) { return dims >= 2 && dims <= kMaxAxes; }
+#if FDSURF_DEVICE_PLANNER
 bool LinesValid(uint16_t lines) { return lines == 0 || (lines >= 2 && lines <= kMaxLines); }
+#endif
 
 // Both 0 (a plain switch pen) or each a servo pulse width: one encoding of
 // "no servo", and no width a servo could be driven to the end stop by.
@@ -298,6 +327,7 @@ GeometryFixed ReadGeometry(Reader* r, bool used, uint8_t field) {
   return GeometryFixed::FromRaw(raw);
 }
 
+#if FDSURF_DEVICE_PLANNER
 void ReadPatch(Reader* r, PatchCommand* p) {
   const uint8_t basis = r->U8(kPatchFieldBasis);
   r->Check(BasisValid(basis), kPatchFieldBasis);
@@ -341,6 +371,30 @@ void ReadCurve(Reader* r, CurveCommand* c) {
     }
   }
   r->End(static_cast<uint8_t>(kCurveFieldGeometry + 4 * axes));
+}
+
+#endif  // FDSURF_DEVICE_PLANNER
+
+// The power coefficients are in the geometry's range (|raw| < 2^47), as
+// CurvePowerCoefficients and the isoline walker produce them; the level is
+// one the planner can choose. Whether the level meets the tolerance is the
+// device's check (PrepareAdaptiveCurveAtLevel), not the codec's.
+void ReadPreparedCurve(Reader* r, PreparedCurveCommand* c) {
+  c->dims = r->U8(kPreparedCurveFieldDims);
+  r->Check(DimsValid(c->dims), kPreparedCurveFieldDims);
+  c->level = r->U8(kPreparedCurveFieldLevel);
+  r->Check(c->level <= kMaxAdaptiveLevel, kPreparedCurveFieldLevel);
+  c->tolerance_q8 = r->U32(kPreparedCurveFieldTolerance);
+  r->Check(c->tolerance_q8 > 0, kPreparedCurveFieldTolerance);
+  const int axes = r->ok() ? c->dims : 0;
+  uint8_t field = kPreparedCurveFieldPower;
+  for (int a = 0; a < kMaxAxes; ++a) {
+    for (int64_t& coefficient : c->power[a].c) {
+      coefficient = a < axes ? ReadGeometry(r, true, field).Raw() : 0;
+      ++field;
+    }
+  }
+  r->End(static_cast<uint8_t>(kPreparedCurveFieldPower + 4 * axes));
 }
 
 void ReadMove(Reader* r, MoveCommand* m) {
@@ -513,11 +567,16 @@ DecodeResult DecodeCommand(const Frame& frame, Command* out) {
     case MessageType::kConfig:
       ReadConfig(&reader, &out->body.config);
       break;
+#if FDSURF_DEVICE_PLANNER
     case MessageType::kPatch:
       ReadPatch(&reader, &out->body.patch);
       break;
     case MessageType::kCurve:
       ReadCurve(&reader, &out->body.curve);
+      break;
+#endif
+    case MessageType::kPreparedCurve:
+      ReadPreparedCurve(&reader, &out->body.prepared_curve);
       break;
     case MessageType::kMove:
       ReadMove(&reader, &out->body.move);
@@ -593,7 +652,7 @@ DecodeResult DecodeReply(const Frame& frame, Reply* out) {
       h.max_lines = r.U16(kHelloReplyFieldMaxLines);
       r.Check(h.max_lines >= 2, kHelloReplyFieldMaxLines);
       h.features = r.U8(kHelloReplyFieldFeatures);
-      r.Check((h.features & ~kFeatureEndstops) == 0, kHelloReplyFieldFeatures);
+      r.Check((h.features & ~kKnownFeatures) == 0, kHelloReplyFieldFeatures);
       r.End(kHelloReplyFieldCount);
       break;
     }

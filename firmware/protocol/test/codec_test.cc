@@ -103,6 +103,21 @@ Command Curve(uint8_t dims) {
   return c;
 }
 
+Command Prepared(uint8_t dims) {
+  Command c;
+  c.type = MessageType::kPreparedCurve;
+  c.seq = 0x1234;
+  PreparedCurveCommand& k = c.body.prepared_curve;
+  k = PreparedCurveCommand{};
+  k.dims = dims;
+  k.level = 12;
+  k.tolerance_q8 = 300;
+  for (int a = 0; a < dims; ++a) {
+    for (int i = 0; i < 4; ++i) k.power[a].c[i] = (a * 4 + i - 5) * 987654321LL;
+  }
+  return c;
+}
+
 Command Move(int32_t x, int32_t y, int32_t z) {
   Command c;
   c.type = MessageType::kMove;
@@ -173,6 +188,17 @@ TEST(Codec, CommandRoundTrips) {
   }
   ExpectRoundTrip(Curve(2));
   ExpectRoundTrip(Curve(3));
+  ExpectRoundTrip(Prepared(2));
+  ExpectRoundTrip(Prepared(3));
+  Command extremes = Prepared(3);
+  extremes.body.prepared_curve.level = kMaxAdaptiveLevel;
+  extremes.body.prepared_curve.power[2].c[0] = kGeometryLimitRaw - 1;
+  extremes.body.prepared_curve.power[2].c[1] = -(kGeometryLimitRaw - 1);
+  ExpectRoundTrip(extremes);
+  // dims, level, tolerance (u32), then 4 zigzag varints per axis.
+  const Bytes prepared_body = CommandBody(Prepared(2));
+  EXPECT_EQ(Bytes(prepared_body.begin(), prepared_body.begin() + 6),
+            (Bytes{2, 12, 0x2C, 0x01, 0, 0}));
   ExpectRoundTrip(Move(0, 0, 0));
   ExpectRoundTrip(Move(kMaxTravelSteps, 1, 127));
   ExpectRoundTrip(Pen(true));
@@ -387,6 +413,22 @@ TEST(CodecValidation, CurveMovePen) {
     m.body.move.target[a] = kMaxTravelSteps + 1;
     ExpectRefused(m, bad, static_cast<uint8_t>(kMoveFieldTarget + a));
   }
+  c = Prepared(3);
+  c.body.prepared_curve.dims = 1;
+  ExpectRefused(c, bad, kPreparedCurveFieldDims);
+  c = Prepared(2);
+  c.body.prepared_curve.level = kMaxAdaptiveLevel + 1;
+  ExpectRefused(c, bad, kPreparedCurveFieldLevel);
+  c = Prepared(2);
+  c.body.prepared_curve.tolerance_q8 = 0;
+  ExpectRefused(c, bad, kPreparedCurveFieldTolerance);
+  for (int a = 0; a < 3; ++a) {
+    for (int i = 0; i < 4; ++i) {
+      c = Prepared(3);
+      c.body.prepared_curve.power[a].c[i] = kGeometryLimitRaw;
+      ExpectRefused(c, bad, static_cast<uint8_t>(kPreparedCurveFieldPower + 4 * a + i));
+    }
+  }
   const Bytes pen2 = {2};
   Command out;
   const DecodeResult r = DecodeCommand(BodyFrame(MessageType::kPen, pen2), &out);
@@ -396,9 +438,9 @@ TEST(CodecValidation, CurveMovePen) {
 
 TEST(CodecValidation, ExactLength) {
   const Command commands[] = {
-      Config(),     Patch(2, 3),         Patch(3, 4), Curve(2),
-      Curve(3),     Move(5, 300, 70000), Pen(true),   Home(0x03, 0x01, 800, 40),
-      Motors(false)};
+      Config(),    Patch(2, 3),         Patch(3, 4),  Curve(2),
+      Curve(3),    Move(5, 300, 70000), Pen(true),    Home(0x03, 0x01, 800, 40),
+      Prepared(2), Prepared(3),         Motors(false)};
   for (const Command& c : commands) {
     const Bytes body = CommandBody(c);
     Command out;
@@ -475,7 +517,7 @@ TEST(CodecValidation, UnknownTypes) {
   const Bytes body = {1};
   for (int type = 0; type < 256; ++type) {
     const DecodeResult r = DecodeCommand(BodyFrame(static_cast<MessageType>(type), body), &out);
-    if (type >= 0x10 && type <= 0x16) {
+    if (type >= 0x10 && type <= 0x17) {
       EXPECT_NE(r.code, ErrorCode::kUnknownType);
     } else {
       EXPECT_EQ(r.code, ErrorCode::kUnknownType) << type;
@@ -647,7 +689,9 @@ TEST(CodecValidation, Replies) {
   Bytes tick0 = good;
   tick0[5] = 0;
   EXPECT_EQ(decode(MessageType::kHelloReply, tick0).field, kHelloReplyFieldTickHz);
-  EXPECT_EQ(hello_with(12, 0x02).field, kHelloReplyFieldFeatures);  // unknown feature
+  EXPECT_EQ(hello_with(12, kFeaturePreparedCurves).code, ErrorCode::kNone);
+  EXPECT_EQ(hello_with(12, kFeaturePlanner).code, ErrorCode::kNone);
+  EXPECT_EQ(hello_with(12, 0x08).field, kHelloReplyFieldFeatures);  // unknown feature
   const Bytes no_features(good.begin(), good.end() - 1);
   EXPECT_EQ(decode(MessageType::kHelloReply, no_features).field, kHelloReplyFieldFeatures);
   // STATUS_REPORT: state, error code and pen byte ranges.

@@ -333,6 +333,16 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
     throw DeviceError(device + ": the device drives " + std::to_string(hello.max_axes) +
                       " axes; the job needs " + std::to_string(job.config.axes) + " (--dims)");
   }
+  if ((hello.features & protocol::kFeaturePlanner) == 0) {
+    for (const protocol::Command& command : job.commands) {
+      if (command.type == protocol::MessageType::kPatch ||
+          command.type == protocol::MessageType::kCurve) {
+        throw DeviceError(device +
+                          ": the device has no planner of its own (it takes PREPARED_CURVE, not "
+                          "PATCH or CURVE): stream with --prepare-on-host");
+      }
+    }
+  }
   const std::uint32_t tick_hz = hello.tick_hz;
   if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return job;
   StreamJob fitted = job;

@@ -304,7 +304,9 @@ class Device {
   FDSURF_NODISCARD uint32_t TickHz() const { return tick_hz_; }
   FDSURF_NODISCARD uint8_t MaxAxes() const { return static_cast<uint8_t>(kAxes); }
   FDSURF_NODISCARD uint8_t Features() const {
-    return endstops_ != nullptr ? protocol::kFeatureEndstops : 0;
+    const uint8_t endstops = endstops_ != nullptr ? protocol::kFeatureEndstops : 0;
+    const uint8_t planner = FDSURF_DEVICE_PLANNER ? protocol::kFeaturePlanner : 0;
+    return static_cast<uint8_t>(endstops | planner | protocol::kFeaturePreparedCurves);
   }
 
   void FillStatus(protocol::StatusReport* report) const {

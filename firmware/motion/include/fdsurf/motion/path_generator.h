@@ -41,12 +41,25 @@ constexpr int kHullMaxDepth = 20;
 constexpr uint16_t kHullTestBudget = 64;
 constexpr uint8_t kUndecidedTravel = 0x80;
 
+/// "The device's planner chooses the level" where a level may come from the
+/// host (PREPARED_CURVE).
+constexpr int8_t kPlannerLevel = -1;
+
 /// Work done by ValidateCommand, counted for tests and cost models: lines
 /// put through the planner, and hull tests of the travel check's halving.
 struct ValidationWork {
   uint32_t lines;
   uint32_t hull_tests;
 };
+
+/// The finest level of a straight move `line` (c[0] = c[1] = 0): the
+/// smallest L at which one step of 2^-L moves at most one step per axis,
+/// |c| ≤ 2^(16+L). That is the level the planner chooses for a line (a line
+/// has no second difference, so its chord test passes at every level), so
+/// moves are set up by PrepareAdaptiveCurveAtLevel at it, with the same bits
+/// and without the planner's search and wide integers.
+template <int kDims>
+int StraightMoveLevel(const PowerCurve1 (&line)[kDims]);
 
 /// Whether every axis's travel is at most kMaxPlannableTravelSteps; *axis =
 /// the first that is not.
@@ -111,8 +124,9 @@ class PathGenerator {
     kFinish,         // pen up (patch), then the command-done entry
   };
 
-  /// Prepares `curve` into prepared_ and points the cursor at it.
-  bool PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8);
+  /// Prepares `curve` into prepared_ (by the planner for kPlannerLevel,
+  /// else at the host's level) and points the cursor at it.
+  bool PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level);
   bool NextPoint(int32_t (&point)[kDims]);
   /// Queues an entry to hand out before anything else.
   void Emit(uint8_t entry);
@@ -130,13 +144,17 @@ class PathGenerator {
   Status failure_ = Status::kOk;
   int32_t position_[kDims] = {};
 
+#if FDSURF_DEVICE_PLANNER
   // Patch state.
   IsolineWalker<kDims> walker_;
   IsolineFamily family_ = IsolineFamily::kSLines;
   uint16_t lines_t_ = 0;
   uint16_t line_index_ = 0;
-  uint32_t tolerance_q8_ = 0;
   protocol::PatchCommand patch_;  // kept for the t-line walker
+#endif
+  uint32_t tolerance_q8_ = 0;
+  /// The finest level of a PREPARED_CURVE, or kPlannerLevel.
+  int8_t host_level_ = kPlannerLevel;
 
   // The line to draw (power coefficients, 2^-16 steps) and its first point;
   // the path being stepped now (the line, or a straight travel move to it).
@@ -157,6 +175,54 @@ class PathGenerator {
 /// The power coefficients of the same curve run backwards: x(1 − u). Exact.
 template <int kDims>
 void ReverseCurve(PowerCurve1 (&curve)[kDims]);
+
+/// Whether a line is a single point (a pole of the patch): it draws nothing.
+template <int kDims>
+bool IsPoint(const PowerCurve1 (&curve)[kDims]) {
+  for (int c = 0; c < kDims; ++c) {
+    if (curve[c].c[0] != 0 || curve[c].c[1] != 0 || curve[c].c[2] != 0) return false;
+  }
+  return true;
+}
+
+/// Whether line `index` of `lines` in a family is an edge that
+/// PatchCommand::skip_lines says another patch draws.
+inline bool IsSkippedEdge(uint8_t skip_lines, IsolineFamily family, uint16_t index,
+                          uint16_t lines) {
+  const uint8_t first =
+      family == IsolineFamily::kSLines ? protocol::kSkipFirstSLine : protocol::kSkipFirstTLine;
+  const uint8_t last =
+      family == IsolineFamily::kSLines ? protocol::kSkipLastSLine : protocol::kSkipLastTLine;
+  return (index == 0 && (skip_lines & first) != 0) ||
+         (index + 1u == lines && (skip_lines & last) != 0);
+}
+
+/// The lines of one family of a PATCH that the device draws, in its order
+/// and direction: every other line reversed (serpentine), poles and the
+/// edges in skip_lines left out. Calls line(curve) with each line's power
+/// coefficients (2^-16 steps) until it returns false. PathGenerator draws
+/// these lines (one at a time, as the motion loop pulls them); a host that
+/// sends a patch as PREPARED_CURVEs walks them with this. Returns the
+/// walker's refusal (kInvalidArgument, kGridOutOfRange, kGeometryOutOfRange)
+/// or kOk; a family of 0 lines has none.
+template <int kDims, typename LineFn>
+Status ForEachDrawnLine(const protocol::PatchCommand& patch, IsolineFamily family, LineFn&& line) {
+  const uint16_t lines = family == IsolineFamily::kSLines ? patch.lines_s : patch.lines_t;
+  if (lines == 0) return Status::kOk;
+  PatchGeometry1 geometry[kDims];
+  for (int c = 0; c < kDims; ++c) geometry[c] = patch.geometry[c];
+  IsolineWalker<kDims> walker;
+  const Status created =
+      IsolineWalker<kDims>::Create(geometry, patch.basis, family, lines, &walker);
+  if (created != Status::kOk) return created;
+  PowerCurve1 curve[kDims];
+  for (uint16_t index = 0; walker.Next(curve); ++index) {
+    if (IsPoint(curve) || IsSkippedEdge(patch.skip_lines, family, index, lines)) continue;
+    if ((index & 1u) != 0) ReverseCurve(curve);
+    if (!line(static_cast<const PowerCurve1(&)[kDims]>(curve))) break;
+  }
+  return Status::kOk;
+}
 
 }  // namespace motion
 }  // namespace fdsurf

@@ -65,6 +65,11 @@ constexpr uint8_t kCurveFieldBasis = 0;
 constexpr uint8_t kCurveFieldDims = 1;
 constexpr uint8_t kCurveFieldTolerance = 2;
 constexpr uint8_t kCurveFieldGeometry = 3;
+// kPreparedCurve: power[axis].c[k] is field kPreparedCurveFieldPower + 4·axis + k.
+constexpr uint8_t kPreparedCurveFieldDims = 0;
+constexpr uint8_t kPreparedCurveFieldLevel = 1;
+constexpr uint8_t kPreparedCurveFieldTolerance = 2;
+constexpr uint8_t kPreparedCurveFieldPower = 3;
 // kMove: target[axis] is field axis.
 constexpr uint8_t kMoveFieldTarget = 0;
 constexpr uint8_t kMoveFieldCount = 3;

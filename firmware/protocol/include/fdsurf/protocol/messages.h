@@ -12,8 +12,21 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fdsurf/adaptive.h"
 #include "fdsurf/basis.h"
 #include "fdsurf/forward_difference.h"
+
+/// 1 (the default): the device sets PATCH and CURVE up itself, with the
+/// planner (PrepareAdaptiveCurve, the isoline walker, CurvePowerCoefficients).
+/// 0: a device without the planner, for small chips (the Arduino Uno, issue
+/// 17). It takes PREPARED_CURVE, MOVE, PEN, HOME and MOTORS and refuses PATCH
+/// and CURVE as unknown types (HELLO_REPLY's features say so), and it holds
+/// none of their state, so its commands are smaller too. A firmware build
+/// defines it for every file (CMake: FDSURF_DEVICE_PLANNER); the host always
+/// has the planner.
+#ifndef FDSURF_DEVICE_PLANNER
+#define FDSURF_DEVICE_PLANNER 1
+#endif
 
 namespace fdsurf {
 namespace protocol {
@@ -23,7 +36,9 @@ namespace protocol {
 /// Version 3 adds PAUSE, RESUME and HALT, and the machine's pen hardware and
 /// limits in CONFIG, and homing (HOME, MOTORS, MachineConfig::flags, the
 /// status flags and HELLO_REPLY's features): issue 15, docs/protocol.md.
-constexpr uint8_t kProtocolVersion = 3;
+/// Version 4 adds PREPARED_CURVE (a curve the host has planned) and the
+/// feature bit that says a device takes it: issue 17.
+constexpr uint8_t kProtocolVersion = 4;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
 /// Largest number of axes a device drives (X, Y and optionally Z).
@@ -45,13 +60,14 @@ enum class MessageType : uint8_t {
   /// the pen, disable the motors; answered by kAck.
   kHalt = 0x06,
 
-  kConfig = 0x10,  ///< MachineConfig
-  kPatch = 0x11,   ///< PatchCommand
-  kCurve = 0x12,   ///< CurveCommand
-  kMove = 0x13,    ///< MoveCommand
-  kPen = 0x14,     ///< PenCommand
-  kHome = 0x15,    ///< HomeCommand
-  kMotors = 0x16,  ///< MotorsCommand
+  kConfig = 0x10,         ///< MachineConfig
+  kPatch = 0x11,          ///< PatchCommand
+  kCurve = 0x12,          ///< CurveCommand
+  kMove = 0x13,           ///< MoveCommand
+  kPen = 0x14,            ///< PenCommand
+  kHome = 0x15,           ///< HomeCommand
+  kMotors = 0x16,         ///< MotorsCommand
+  kPreparedCurve = 0x17,  ///< PreparedCurveCommand
 
   kHelloReply = 0x81,
   kStatusReport = 0x82,
@@ -159,6 +175,28 @@ struct CurveCommand {
   CurveGeometry1 geometry[kMaxAxes];
 };
 
+/// CURVE as the host has planned it ("the host computes, the device adds"):
+/// the curve's power coefficients, already rounded once to 2^-16 steps, and
+/// the finest level the host's planner chose. The device checks that level
+/// with shifts and additions only (PrepareAdaptiveCurveAtLevel: the same
+/// tests as the planner, no search, no wide integers, no divide) and steps
+/// the exact table it forms; everything else is as for CURVE (a straight
+/// move to the start first if the machine is elsewhere, the current pen
+/// state, a step-exact path within the tolerance). A patch is sent as its
+/// drawn isolines, each a PREPARED_CURVE (docs/protocol.md, "Prepared
+/// curves").
+struct PreparedCurveCommand {
+  /// Equal to the configured axes.
+  uint8_t dims;
+  /// The finest step is 2^-level, 0..kMaxAdaptiveLevel.
+  uint8_t level;
+  /// Euclidean tolerance in 2^-8 steps (as AdaptiveSettings::tolerance_q8).
+  uint32_t tolerance_q8;
+  /// a·u³ + b·u² + c·u + d per axis, u from 0 to 1, in 2^-16 steps
+  /// (|each| < 2^47); only [0, dims) used.
+  PowerCurve1 power[kMaxAxes];
+};
+
 /// A straight move to `target` (steps) with the current pen state.
 struct MoveCommand {
   int32_t target[kMaxAxes];
@@ -199,8 +237,11 @@ struct Command {
   union Body {
     Body() : pen{false} {}
     MachineConfig config;
+#if FDSURF_DEVICE_PLANNER
     PatchCommand patch;
     CurveCommand curve;
+#endif
+    PreparedCurveCommand prepared_curve;
     MoveCommand move;
     PenCommand pen;
     HomeCommand home;
@@ -267,6 +308,13 @@ struct HelloReply {
 
 /// HelloReply::features: the device reads endstop inputs (HOME can work).
 constexpr uint8_t kFeatureEndstops = 0x01;
+/// HelloReply::features: the device takes PREPARED_CURVE.
+constexpr uint8_t kFeaturePreparedCurves = 0x02;
+/// HelloReply::features: the device has the planner (FDSURF_DEVICE_PLANNER)
+/// and takes PATCH and CURVE; without it, the host sends PREPARED_CURVEs.
+constexpr uint8_t kFeaturePlanner = 0x04;
+/// Every feature bit this version knows; a HELLO_REPLY with another is refused.
+constexpr uint8_t kKnownFeatures = kFeatureEndstops | kFeaturePreparedCurves | kFeaturePlanner;
 
 struct StatusReport {
   DeviceState state;

@@ -178,6 +178,25 @@ std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
                          const MachineOptions& machine, const std::string& units);
 
+/// `fdsurf stream --prepare-on-host`: the job with every PATCH and CURVE
+/// replaced by what the device draws for it, planned here ("the host
+/// computes, the device adds"; docs/protocol.md, "Prepared curves"), so that
+/// the device needs no planner:
+/// - a CURVE becomes one PREPARED_CURVE: the same power coefficients, at
+///   the finest level this host's planner (PrepareAdaptiveCurve, the
+///   device's own) chooses;
+/// - a PATCH becomes, for every line the device draws of it
+///   (motion::ForEachDrawnLine, in its order and direction), a pen-up and a
+///   MOVE to the line's first point unless the previous line ended there, a
+///   pen-down and the line's PREPARED_CURVE; then a pen-up.
+/// The device then makes the same unit moves and pen changes as for the
+/// PATCH and CURVE commands (a pen-up with the pen up, and a MOVE to where
+/// the machine is, make none). Labels follow their commands ("patch 3 (…)
+/// s-line 2"), and layers their first command. Throws EngineError for a
+/// line the planner refuses (BuildStreamJob's check rules that out for the
+/// jobs it builds).
+void PrepareOnHost(StreamJob* job);
+
 /// `fdsurf stream --hidden remove`: the visible pieces of a drawing as a
 /// flat drawing of Bézier curves, which BuildStreamJob(set, options,
 /// machine, units) streams like any file's curves (CURVE commands, straight
