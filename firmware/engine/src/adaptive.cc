@@ -93,32 +93,12 @@ Status FinestLevel(const uint64_t (&m)[kDims][4], int64_t budget16, bool step_ex
   }
 }
 
-// The accumulator: every value the stepper forms (differences at any level
-// up to step 1, the doubling and halving intermediates, the rounding half)
-// is below 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F; 64 bits when that
-// fits in 62 (and F ≤ 62), else 128 when it fits in 126.
-template <int kDims>
-Status AccumulatorBits(const uint64_t (&m)[kDims][4], int level, int frac_bits,
-                       const AdaptiveSettings& settings, int* out) {
-  Wide largest;
-  for (int c = 0; c < kDims; ++c) {
-    const Wide bound = Wide::FromUint64(8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3]))
-                           .ShiftedLeft(3 * level) +
-                       Wide::PowerOfTwo(frac_bits);
-    if (largest < bound) largest = bound;
-  }
-  if (frac_bits <= 62 && largest < Wide::PowerOfTwo(62) && settings.max_acc_bits >= 64) {
-    *out = 64;
-  } else if (largest < Wide::PowerOfTwo(126) && settings.max_acc_bits >= 128) {
-    *out = 128;
-  } else {
-    return Status::kPrecisionUnreachable;
-  }
-  return Status::kOk;
-}
-
 }  // namespace
 
+// The search for the level is the planner's own (FinestLevel, in WideInt);
+// PrepareAdaptiveCurveAtLevel then checks that level in Int128 (the same
+// tests, and the accumulator: docs/toolpaths.md, "Choosing the finest level,
+// and the range") and forms the table, so that the table has one home.
 template <int kDims>
 Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
                             PreparedAdaptiveCurve<kDims>* out) {
@@ -131,38 +111,7 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
   int level = 0;
   status = FinestLevel(m, budget16, settings.mode == AdaptiveMode::kStepExact, &level);
   if (status != Status::kOk) return status;
-  const int frac_bits = kCoefficientFracBits + 3 * level;
-  int acc_bits = 0;
-  status = AccumulatorBits(m, level, frac_bits, settings, &acc_bits);
-  if (status != Status::kOk) return status;
-
-  PreparedAdaptiveCurve<kDims> result;
-  result.format.acc_bits = static_cast<uint8_t>(acc_bits);
-  result.format.frac_bits = static_cast<uint8_t>(frac_bits);
-  result.format.word_aligned = 0;  // The cursor halves and doubles its steps.
-  result.finest_level = static_cast<uint8_t>(level);
-  result.mode = settings.mode;
-  for (int c = 0; c < kDims; ++c) {
-    const Wide a = Wide::FromInt64(curve[c].c[0]);
-    const Wide b = Wide::FromInt64(curve[c].c[1]);
-    const Wide cc = Wide::FromInt64(curve[c].c[2]);
-    const Wide d = Wide::FromInt64(curve[c].c[3]);
-    // Step h = 2^-L in units of 2^-(16+3L): Δ⁰ = d·2^3L, Δ¹ = a + b·2^L + c·2^2L,
-    // Δ² = 6a + 2b·2^L, Δ³ = 6a.
-    result.d[c][0] = internal::ToInt128(d.ShiftedLeft(3 * level));
-    result.d[c][1] = internal::ToInt128(a + b.ShiftedLeft(level) + cc.ShiftedLeft(2 * level));
-    result.d[c][2] = internal::ToInt128(a.MulInt64(6) + b.ShiftedLeft(level + 1));
-    result.d[c][3] = internal::ToInt128(a.MulInt64(6));
-  }
-  // Values never exceed the accumulator bound, so a larger limit would act
-  // the same; clamping keeps it representable in the accumulator.
-  Wide chord_limit = Wide::FromUint64(static_cast<uint64_t>(budget16)).ShiftedLeft(3 + 3 * level);
-  const Wide clamp = Wide::PowerOfTwo(acc_bits - 2);
-  if (clamp < chord_limit) chord_limit = clamp;
-  result.chord_limit = internal::ToInt128(chord_limit);
-  result.step_limit = internal::ToInt128(Wide::PowerOfTwo(frac_bits));
-  *out = result;
-  return Status::kOk;
+  return PrepareAdaptiveCurveAtLevel(curve, level, settings, out);
 }
 
 namespace {
@@ -189,44 +138,62 @@ bool Below(const Int128& value, int bits) {
                     : value.hi == 0 && value.lo < (uint64_t{1} << bits);
 }
 
-// The level's tests, as FinestLevel and AccumulatorBits make them, in
-// Int128 arithmetic. With every coefficient below 2^47 (CoefficientMagnitudes)
+// The level's tests in Int128 arithmetic: FinestLevel's (which searches
+// with them in WideInt), and the accumulator's: every value the stepper forms
+// (differences at any level up to step 1, the doubling and halving
+// intermediates, the rounding half) is below
+// B = 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F; 64 bits when B < 2^62 (and
+// F ≤ 62), else 128 when B < 2^126. With every coefficient below 2^47 (CoefficientMagnitudes)
 // the sum S = 22|a| + 5|b| + 2|c| + |d| is below 2^52, so 8·S < 2^55 is
 // shifted by 3L ≤ 90 only once it is known to stay below 2^126; then
 // (6|a| + 2|b|)·2^L + 6|a| ≤ 8·S·2^(3L) < 2^126 too, and the chord limit is
 // only formed when it is below 2^126 (else it exceeds every value the curve
-// has, and the test passes). *acc_bits: 64 or 128.
-template <int kDims>
-Status LevelFits(const uint64_t (&m)[kDims][4], int level, int64_t budget16,
-                 const AdaptiveSettings& settings, int* acc_bits) {
+// has, and the test passes).
+//
+// One axis at a time, in functions that are not templates, so that the 1-,
+// 2- and 3-D set-ups share their code (Int128 arithmetic is long on 8-bit
+// cores). *fits64 is cleared when the axis needs the Int128 accumulator.
+FDSURF_OUT_OF_LINE_ON_AVR Status AxisFitsLevel(const uint64_t (&m)[4], int level, int64_t budget16,
+                                               bool step_exact, bool* fits64) {
   const int frac_bits = kCoefficientFracBits + 3 * level;
   const int scale = 3 + 3 * level;  // the chord limit is budget16·8·2^(3L)
-  bool fits64 = frac_bits <= 62 && settings.max_acc_bits >= 64;
-  for (int c = 0; c < kDims; ++c) {
-    const uint64_t eight_sum = 8 * (22 * m[c][0] + 5 * m[c][1] + 2 * m[c][2] + m[c][3]);
-    if (!Below(Int128{eight_sum, 0}, 126 - 3 * level)) return Status::kPrecisionUnreachable;
-    Int128 bound = ShiftedUp(eight_sum, 3 * level);
-    bound += ShiftedUp(1, frac_bits);
-    if (!Below(bound, 126)) return Status::kPrecisionUnreachable;
-    fits64 = fits64 && Below(bound, 62);
-    const Int128 second = ShiftedUp(6 * m[c][0] + 2 * m[c][1], level) + Int128{6 * m[c][0], 0};
-    const uint64_t budget = static_cast<uint64_t>(budget16);
-    const bool chord_limit_below_second =
-        Below(Int128{budget, 0}, 126 - scale) && !(second <= ShiftedUp(budget, scale));
-    if (chord_limit_below_second) return Status::kPrecisionUnreachable;
-    if (settings.mode == AdaptiveMode::kStepExact &&
-        (uint64_t{1} << (kCoefficientFracBits + level)) < 3 * m[c][0] + 2 * m[c][1] + m[c][2]) {
-      return Status::kPrecisionUnreachable;
-    }
-  }
-  if (fits64) {
-    *acc_bits = 64;
-  } else if (settings.max_acc_bits >= 128) {
-    *acc_bits = 128;
-  } else {
+  const uint64_t eight_sum = 8 * (22 * m[0] + 5 * m[1] + 2 * m[2] + m[3]);
+  if (!Below(Int128{eight_sum, 0}, 126 - 3 * level)) return Status::kPrecisionUnreachable;
+  Int128 bound = ShiftedUp(eight_sum, 3 * level);
+  bound += ShiftedUp(1, frac_bits);
+  if (!Below(bound, 126)) return Status::kPrecisionUnreachable;
+  *fits64 = *fits64 && Below(bound, 62);
+  const Int128 second = ShiftedUp(6 * m[0] + 2 * m[1], level) + Int128{6 * m[0], 0};
+  const uint64_t budget = static_cast<uint64_t>(budget16);
+  const bool chord_limit_below_second =
+      Below(Int128{budget, 0}, 126 - scale) && !(second <= ShiftedUp(budget, scale));
+  if (chord_limit_below_second) return Status::kPrecisionUnreachable;
+  if (step_exact && (uint64_t{1} << (kCoefficientFracBits + level)) < 3 * m[0] + 2 * m[1] + m[2]) {
     return Status::kPrecisionUnreachable;
   }
   return Status::kOk;
+}
+
+// One axis's table at step h = 2^-L, in units of 2^-(16+3L): Δ⁰ = d·2^3L,
+// Δ¹ = a + b·2^L + c·2^2L, Δ² = 6a + 2b·2^L, Δ³ = 6a; every term is below B.
+FDSURF_OUT_OF_LINE_ON_AVR void AxisTable(const PowerCurve1& axis, int level, Int128 (&d)[4]) {
+  const Int128 a = internal::Widen(axis.c[0]);
+  const Int128 b = internal::Widen(axis.c[1]);
+  const Int128 six_a = internal::ShiftLeft(a, 2) + internal::ShiftLeft(a, 1);
+  d[0] = ShiftedBy(internal::Widen(axis.c[3]), 3 * level);
+  d[1] = a + ShiftedBy(b, level) + ShiftedBy(internal::Widen(axis.c[2]), 2 * level);
+  d[2] = six_a + ShiftedBy(b, level + 1);
+  d[3] = six_a;
+}
+
+// min(budget16·8·2^(3L), 2^(acc_bits − 2)): values never exceed B, so a
+// larger limit would act the same, and the clamp keeps it representable.
+Int128 ChordLimit(int64_t budget16, int level, int acc_bits) {
+  const int clamp_bits = acc_bits - 2;
+  const uint64_t budget = static_cast<uint64_t>(budget16);
+  const int scale = 3 + 3 * level;
+  const bool below_clamp = clamp_bits > scale && Below(Int128{budget, 0}, clamp_bits - scale);
+  return below_clamp ? ShiftedUp(budget, scale) : ShiftedUp(1, clamp_bits);
 }
 
 }  // namespace
@@ -242,35 +209,25 @@ Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
   Status status = CoefficientMagnitudes(curve, m);
   if (status != Status::kOk) return status;
   if (level < 0 || level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
-  int acc_bits = 0;
-  status = LevelFits(m, level, budget16, settings, &acc_bits);
-  if (status != Status::kOk) return status;
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+  bool fits64 = frac_bits <= 62 && settings.max_acc_bits >= 64;
+  for (int c = 0; c < kDims; ++c) {
+    status =
+        AxisFitsLevel(m[c], level, budget16, settings.mode == AdaptiveMode::kStepExact, &fits64);
+    if (status != Status::kOk) return status;
+  }
+  if (!fits64 && settings.max_acc_bits < 128) return Status::kPrecisionUnreachable;
+  const int acc_bits = fits64 ? 64 : 128;
 
   PreparedAdaptiveCurve<kDims> result;
   result.format.acc_bits = static_cast<uint8_t>(acc_bits);
-  result.format.frac_bits = static_cast<uint8_t>(kCoefficientFracBits + 3 * level);
+  result.format.frac_bits = static_cast<uint8_t>(frac_bits);
   result.format.word_aligned = 0;  // The cursor halves and doubles its steps.
   result.finest_level = static_cast<uint8_t>(level);
   result.mode = settings.mode;
-  for (int c = 0; c < kDims; ++c) {
-    // As PrepareAdaptiveCurve forms them; every term is below the bound.
-    const Int128 a = internal::Widen(curve[c].c[0]);
-    const Int128 b = internal::Widen(curve[c].c[1]);
-    const Int128 cc = internal::Widen(curve[c].c[2]);
-    const Int128 d = internal::Widen(curve[c].c[3]);
-    const Int128 six_a = internal::ShiftLeft(a, 2) + internal::ShiftLeft(a, 1);
-    result.d[c][0] = ShiftedBy(d, 3 * level);
-    result.d[c][1] = a + ShiftedBy(b, level) + ShiftedBy(cc, 2 * level);
-    result.d[c][2] = six_a + ShiftedBy(b, level + 1);
-    result.d[c][3] = six_a;
-  }
-  // min(budget16·8·2^(3L), 2^(acc_bits − 2)), as PrepareAdaptiveCurve clamps.
-  const int clamp_bits = acc_bits - 2;
-  const uint64_t budget = static_cast<uint64_t>(budget16);
-  const int scale = 3 + 3 * level;
-  const bool below_clamp = clamp_bits > scale && Below(Int128{budget, 0}, clamp_bits - scale);
-  result.chord_limit = below_clamp ? ShiftedUp(budget, scale) : ShiftedUp(1, clamp_bits);
-  result.step_limit = ShiftedUp(1, result.format.frac_bits);
+  for (int c = 0; c < kDims; ++c) AxisTable(curve[c], level, result.d[c]);
+  result.chord_limit = ChordLimit(budget16, level, acc_bits);
+  result.step_limit = ShiftedUp(1, frac_bits);
   *out = result;
   return Status::kOk;
 }

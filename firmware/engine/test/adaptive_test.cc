@@ -272,26 +272,61 @@ TEST(AdaptiveCurve, RefusesWhatItCannotServe) {
   EXPECT_EQ(curve.format.acc_bits, 128);
 }
 
-bool SamePrepared(const PreparedAdaptiveCurve<3>& x, const PreparedAdaptiveCurve<3>& y) {
-  if (x.format.acc_bits != y.format.acc_bits || x.format.frac_bits != y.format.frac_bits ||
-      x.finest_level != y.finest_level || x.mode != y.mode || !(x.chord_limit == y.chord_limit) ||
-      !(x.step_limit == y.step_limit)) {
-    return false;
-  }
+I128 FromInt128(const Int128& v) {
+  return I128(static_cast<std::int64_t>(v.hi)) * (I128(1) << 64) + I128(v.lo);
+}
+
+// The prepared curve against the formulas of docs/toolpaths.md, evaluated
+// here in __int128 and long double: the table Δ⁰..Δ³ at step 2^-L, the step
+// limit 2^F, the chord limit min(budget·2^(3+3L), 2^(acc−2)), and the
+// accumulator the bound 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) + 2^F calls for
+// (64-bit below 2^62 with F ≤ 62; not decided here within 10^-9 of 2^62).
+void ExpectTheDocumentedTable(const PowerCurve1 (&raw)[3], const AdaptiveSettings& settings,
+                              const PreparedAdaptiveCurve<3>& curve, int trial) {
+  const int level = curve.finest_level;
+  const int frac_bits = 16 + 3 * level;
+  ASSERT_EQ(curve.format.frac_bits, frac_bits) << trial;
+  long double bound = 0;
   for (int c = 0; c < 3; ++c) {
-    for (int k = 0; k < 4; ++k) {
-      if (!(x.d[c][k] == y.d[c][k])) return false;
-    }
+    const I128 a = raw[c].c[0], b = raw[c].c[1], cc = raw[c].c[2], d = raw[c].c[3];
+    ASSERT_TRUE(FromInt128(curve.d[c][0]) == d * (I128(1) << (3 * level))) << trial;
+    ASSERT_TRUE(FromInt128(curve.d[c][1]) ==
+                a + b * (I128(1) << level) + cc * (I128(1) << (2 * level)))
+        << trial;
+    ASSERT_TRUE(FromInt128(curve.d[c][2]) == 6 * a + 2 * b * (I128(1) << level)) << trial;
+    ASSERT_TRUE(FromInt128(curve.d[c][3]) == 6 * a) << trial;
+    const long double sum = 22.0L * std::fabs(static_cast<long double>(raw[c].c[0])) +
+                            5.0L * std::fabs(static_cast<long double>(raw[c].c[1])) +
+                            2.0L * std::fabs(static_cast<long double>(raw[c].c[2])) +
+                            std::fabs(static_cast<long double>(raw[c].c[3]));
+    bound = std::max(bound, std::ldexp(8 * sum, 3 * level) + std::ldexp(1.0L, frac_bits));
   }
-  return true;
+  const long double limit64 = std::ldexp(1.0L, 62);
+  if (std::fabs(bound / limit64 - 1) > 1e-9L) {
+    const bool fits64 = frac_bits <= 62 && bound < limit64 && settings.max_acc_bits >= 64;
+    EXPECT_EQ(curve.format.acc_bits, fits64 ? 64 : 128) << trial;
+  }
+  EXPECT_TRUE(FromInt128(curve.step_limit) == I128(1) << frac_bits) << trial;
+  // The tolerance per axis (256/√3 rounded down: 147) less half a quantum
+  // and 2^-10 quanta, in 2^-16 quanta.
+  const std::int64_t budget16 =
+      static_cast<std::int64_t>(settings.tolerance_q8) * 147 - (1 << 15) - 64;
+  const long double chord = std::ldexp(static_cast<long double>(budget16), 3 + 3 * level);
+  const long double clamp = std::ldexp(1.0L, curve.format.acc_bits - 2);
+  if (chord < clamp) {
+    EXPECT_TRUE(FromInt128(curve.chord_limit) == I128(budget16) << (3 + 3 * level)) << trial;
+  } else {
+    EXPECT_TRUE(FromInt128(curve.chord_limit) == I128(1) << (curve.format.acc_bits - 2)) << trial;
+  }
 }
 
 // The host plans, the device checks the level it is given with shifts and
-// additions only: at the planner's level both give the same bits, below it
-// the check refuses (the planner's level is the smallest that passes), and
-// above it the check accepts exactly while the accumulator still holds the
-// values. The curves span 2^2..2^27 quanta, in both modes and at tolerances
-// from the smallest reachable one, so both accumulators and every refusal
+// additions only. The planner searches for the level in WideInt arithmetic
+// and forms the table with the check: at the planner's level the check
+// accepts and the table is the documented one; below it the check refuses
+// (the planner's level is the smallest that passes), and above it the check
+// accepts while the accumulator still holds the values. The curves span 2^2..2^27 quanta, in both
+// modes and at tolerances from the smallest reachable one, so both accumulators and every refusal
 // are met.
 TEST(AdaptiveCurve, ALevelChosenElsewhereIsCheckedAsThePlannerChecksIt) {
   std::mt19937_64 rng(20261206);
@@ -320,9 +355,9 @@ TEST(AdaptiveCurve, ALevelChosenElsewhereIsCheckedAsThePlannerChecksIt) {
       continue;
     }
     ++planned[by_planner.format.acc_bits == 64 ? 0 : 1];
+    ExpectTheDocumentedTable(raw, settings, by_planner, trial);
     const int level = by_planner.finest_level;
     ASSERT_EQ(PrepareAdaptiveCurveAtLevel(raw, level, settings, &at_level), Status::kOk) << trial;
-    ASSERT_TRUE(SamePrepared(by_planner, at_level)) << trial;
     if (level > 0) {
       ASSERT_EQ(PrepareAdaptiveCurveAtLevel(raw, level - 1, settings, &at_level),
                 Status::kPrecisionUnreachable)

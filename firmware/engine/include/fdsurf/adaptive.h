@@ -99,9 +99,9 @@ Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSet
 /// step of 2^-level within the chord limit and, in kStepExact, within one
 /// quantum, every value the stepper forms below 2^62 for the 64-bit
 /// accumulator or 2^126 for Int128, within settings.max_acc_bits), then forms
-/// the table by shifts and additions. For every curve PrepareAdaptiveCurve
-/// prepares, this at its finest_level gives the same bits; a level above the
-/// planner's may be accepted too (its step tests only get easier), one below
+/// the table by shifts and additions. PrepareAdaptiveCurve is this at the
+/// smallest level whose step tests pass (which it searches for); a level
+/// above it may be accepted too (the step tests only get easier), one below
 /// it is refused. docs/toolpaths.md, "A level chosen by the host".
 /// Errors: kToleranceUnreachable, kGeometryOutOfRange, kPrecisionUnreachable
 /// (level outside 0..kMaxAdaptiveLevel, a step of 2^-level fails a test, or
