@@ -396,6 +396,28 @@ __attribute__((noinline)) void BenchValidate() {
   // the difference is the 19 hull tests.
   config.travel_steps[1] = 17000;
   BenchValidateOne(FDSURF_TEXT("validate-inside"));
+  // The same line as the host would send it (PREPARED_CURVE: its power
+  // coefficients and the planner's level, found here outside the marks):
+  // the check at that level instead of the planner, no hull test.
+  CurveGeometry1 geometry[2] = {curve.geometry[0], curve.geometry[1]};
+  PowerCurve1 power[2];
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = curve.tolerance_q8;
+  PreparedAdaptiveCurve<2> planned;
+  if (CurvePowerCoefficients(geometry, curve.basis, power) != Status::kOk ||
+      PrepareAdaptiveCurve(power, settings, &planned) != Status::kOk) {
+    PortExit(5);
+  }
+  command = protocol::Command();
+  command.type = protocol::MessageType::kPreparedCurve;
+  protocol::PreparedCurveCommand& prepared = command.body.prepared_curve;
+  prepared.dims = 2;
+  prepared.level = planned.finest_level;
+  prepared.tolerance_q8 = settings.tolerance_q8;
+  prepared.power[0] = power[0];
+  prepared.power[1] = power[1];
+  BenchValidateOne(FDSURF_TEXT("validate-prepared"));
 }
 #endif
 

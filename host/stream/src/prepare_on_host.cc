@@ -38,8 +38,7 @@ class Preparer {
         break;
       default:
         Push(command, job_.labels[index]);
-        if (command.type == MessageType::kPen) pen_down_ = command.body.pen.down;
-        at_.reset();  // a MOVE or a CURVE's end: the host does not track it
+        Follow(command);
         break;
     }
   }
@@ -55,6 +54,23 @@ class Preparer {
   void Push(const Command& command, std::string label) {
     commands_.push_back(command);
     labels_.push_back(std::move(label));
+  }
+
+  // What a command passed through leaves: a PEN its pen state, a MOVE the
+  // machine at its target; after anything else (HOME, MOTORS, CONFIG) the
+  // host no longer knows where the machine is.
+  void Follow(const Command& command) {
+    if (command.type == MessageType::kPen) {
+      pen_down_ = command.body.pen.down;
+    } else if (command.type == MessageType::kMove) {
+      std::array<std::int32_t, kDims> target{};
+      for (int c = 0; c < kDims; ++c) {
+        target[static_cast<std::size_t>(c)] = command.body.move.target[c];
+      }
+      at_ = target;
+    } else {
+      at_.reset();
+    }
   }
 
   void Pen(bool down, const std::string& label) {
@@ -86,8 +102,9 @@ class Preparer {
     body.dims = static_cast<std::uint8_t>(kDims);
     body.level = prepared.finest_level;
     body.tolerance_q8 = tolerance_q8;
-    for (int c = 0; c < protocol::kMaxAxes; ++c)
+    for (int c = 0; c < protocol::kMaxAxes; ++c) {
       body.power[c] = c < kDims ? line[c] : PowerCurve1{};
+    }
     Push(command, label);
     std::array<std::int32_t, kDims> end{};
     for (int c = 0; c < kDims; ++c) {
