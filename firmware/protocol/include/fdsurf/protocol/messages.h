@@ -22,8 +22,9 @@
 /// 17). It takes PREPARED_CURVE, MOVE, PEN, HOME and MOTORS and refuses PATCH
 /// and CURVE as unknown types (HELLO_REPLY's features say so), and it holds
 /// none of their state, so its commands are smaller too. A firmware build
-/// defines it for every file (CMake: FDSURF_DEVICE_PLANNER); the host always
-/// has the planner.
+/// defines it for every file of the core and the firmware, as
+/// targets/CMakeLists.txt builds fdsurf_core_prepared; the host always has
+/// the planner.
 #ifndef FDSURF_DEVICE_PLANNER
 #define FDSURF_DEVICE_PLANNER 1
 #endif
