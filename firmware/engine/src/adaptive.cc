@@ -93,29 +93,6 @@ Status FinestLevel(const uint64_t (&m)[kDims][4], int64_t budget16, bool step_ex
   }
 }
 
-}  // namespace
-
-// The search for the level is the planner's own (FinestLevel, in WideInt);
-// PrepareAdaptiveCurveAtLevel then checks that level in Int128 (the same
-// tests, and the accumulator: docs/toolpaths.md, "Choosing the finest level,
-// and the range") and forms the table, so that the table has one home.
-template <int kDims>
-Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
-                            PreparedAdaptiveCurve<kDims>* out) {
-  static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
-  const int64_t budget16 = ChordBudget16(settings.tolerance_q8, kDims);
-  if (budget16 <= 0) return Status::kToleranceUnreachable;
-  uint64_t m[kDims][4];
-  Status status = CoefficientMagnitudes(curve, m);
-  if (status != Status::kOk) return status;
-  int level = 0;
-  status = FinestLevel(m, budget16, settings.mode == AdaptiveMode::kStepExact, &level);
-  if (status != Status::kOk) return status;
-  return PrepareAdaptiveCurveAtLevel(curve, level, settings, out);
-}
-
-namespace {
-
 // PrepareAdaptiveCurveAtLevel's arithmetic: unsigned values below 2^127 in
 // an Int128, shifted by 0 ≤ bits < 128 (the callers keep the result below
 // 2^127 first).
@@ -196,23 +173,27 @@ Int128 ChordLimit(int64_t budget16, int level, int acc_bits) {
   return below_clamp ? ShiftedUp(budget, scale) : ShiftedUp(1, clamp_bits);
 }
 
-}  // namespace
-
+// What the planner and the check at a level both start from: the chord
+// budget and the coefficients' magnitudes, each checked.
 template <int kDims>
-Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
-                                   const AdaptiveSettings& settings,
-                                   PreparedAdaptiveCurve<kDims>* out) {
+Status CurveInputs(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
+                   int64_t* budget16, uint64_t (&m)[kDims][4]) {
   static_assert(kDims >= 1 && kDims <= 3, "1, 2 or 3 coordinates");
-  const int64_t budget16 = ChordBudget16(settings.tolerance_q8, kDims);
-  if (budget16 <= 0) return Status::kToleranceUnreachable;
-  uint64_t m[kDims][4];
-  Status status = CoefficientMagnitudes(curve, m);
-  if (status != Status::kOk) return status;
+  *budget16 = ChordBudget16(settings.tolerance_q8, kDims);
+  if (*budget16 <= 0) return Status::kToleranceUnreachable;
+  return CoefficientMagnitudes(curve, m);
+}
+
+// PrepareAdaptiveCurveAtLevel once CurveInputs has passed.
+template <int kDims>
+Status PrepareAtLevel(const PowerCurve1 (&curve)[kDims], const uint64_t (&m)[kDims][4],
+                      int64_t budget16, int level, const AdaptiveSettings& settings,
+                      PreparedAdaptiveCurve<kDims>* out) {
   if (level < 0 || level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
   const int frac_bits = kCoefficientFracBits + 3 * level;
   bool fits64 = frac_bits <= 62 && settings.max_acc_bits >= 64;
   for (int c = 0; c < kDims; ++c) {
-    status =
+    const Status status =
         AxisFitsLevel(m[c], level, budget16, settings.mode == AdaptiveMode::kStepExact, &fits64);
     if (status != Status::kOk) return status;
   }
@@ -230,6 +211,36 @@ Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
   result.step_limit = ShiftedUp(1, frac_bits);
   *out = result;
   return Status::kOk;
+}
+
+}  // namespace
+
+template <int kDims>
+Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
+                                   const AdaptiveSettings& settings,
+                                   PreparedAdaptiveCurve<kDims>* out) {
+  int64_t budget16 = 0;
+  uint64_t m[kDims][4];
+  const Status status = CurveInputs(curve, settings, &budget16, m);
+  if (status != Status::kOk) return status;
+  return PrepareAtLevel(curve, m, budget16, level, settings, out);
+}
+
+// The search for the level is the planner's own (FinestLevel, in WideInt);
+// PrepareAtLevel then checks that level in Int128 (the same tests, and the
+// accumulator: docs/toolpaths.md, "Choosing the finest level, and the
+// range") and forms the table, so that the table has one home.
+template <int kDims>
+Status PrepareAdaptiveCurve(const PowerCurve1 (&curve)[kDims], const AdaptiveSettings& settings,
+                            PreparedAdaptiveCurve<kDims>* out) {
+  int64_t budget16 = 0;
+  uint64_t m[kDims][4];
+  Status status = CurveInputs(curve, settings, &budget16, m);
+  if (status != Status::kOk) return status;
+  int level = 0;
+  status = FinestLevel(m, budget16, settings.mode == AdaptiveMode::kStepExact, &level);
+  if (status != Status::kOk) return status;
+  return PrepareAtLevel(curve, m, budget16, level, settings, out);
 }
 
 template <int kDims>
