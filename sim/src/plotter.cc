@@ -109,8 +109,8 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
 // Measured under simavr (docs/motion.md): a hull test is validate-graze
 // less validate-inside over its 19 tests; a line is validate-frame per line
 // less its 3 hull tests.
-constexpr std::uint32_t kAvrCyclesPerLine = 430776;
-constexpr std::uint32_t kAvrCyclesPerHullTest = 19982;
+constexpr std::uint32_t kAvrCyclesPerLine = 425039;
+constexpr std::uint32_t kAvrCyclesPerHullTest = 5062;
 
 DeviceCost DeviceCost::Atmega2560() {
   return DeviceCost{16'000'000, kAvrCyclesPerLine, kAvrCyclesPerHullTest};

@@ -378,8 +378,8 @@ __attribute__((noinline)) void BenchValidate() {
   patch.lines_s = patch.lines_t = kBenchValidateLines;
   BenchValidateOne(FDSURF_TEXT("validate-frame"));
   // y = T + (0, 17 142, 64 269, 0) · 2^-16 steps in Bézier form: its top is
-  // 0.22 · 2^-16 step inside T + 1/2; 19 hull tests, the most of 3000
-  // random grazes scaled to within 2^-16 step of the edge.
+  // 0.22 · 2^-16 step inside T + 1/2; 19 hull tests (the most of 3000
+  // random grazes within 3·2^-16 step of the edge is 29, device_motion_test).
   command = protocol::Command();
   command.type = protocol::MessageType::kCurve;
   protocol::CurveCommand& curve = command.body.curve;

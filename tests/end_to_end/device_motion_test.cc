@@ -616,6 +616,169 @@ TEST(ValidateCommand, TheTravelCheckIsSoundAndNearlyExact) {
   EXPECT_GT(refused, 100);
 }
 
+// The travel check's pieces are rounded (64-bit, docs/motion.md): every
+// coefficient of a piece at depth D is within 3D/2 units of the exact one,
+// checked against the piece's exact Bernstein coefficients in __int128 (times
+// 8^D, so that they are integers) for random lines up to the largest travel.
+TEST(ValidateCommand, TheTravelHullIsWithinItsSlackOfTheExactPiece) {
+  std::mt19937_64 random(31);
+  using Wide = __int128;
+  int rounded = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const int bits = 4 + static_cast<int>(random() % 44);  // coefficients up to 2^47
+    std::int64_t k[4];
+    for (std::int64_t& value : k) {
+      value = static_cast<std::int64_t>(random() % (std::uint64_t{1} << bits)) -
+              (std::int64_t{1} << (bits - 1));
+    }
+    const std::int32_t travel = 1 + static_cast<std::int32_t>(random() % (1u << 26));
+    std::uint64_t whole[4];
+    std::uint64_t low3 = 0;
+    std::uint64_t high3 = 0;
+    const int shift = motion::internal::TravelHullOf(k, travel, whole, &low3, &high3);
+    ASSERT_GE(shift, 7);
+    const Wide offset = Wide{1} << 62;
+    EXPECT_EQ(Wide(low3) - offset, Wide{-3 * 32768} << shift);
+    EXPECT_EQ(Wide(high3) - offset, (Wide{3} * (Wide{travel} * 65536 + 32768)) << shift);
+    const int depth = static_cast<int>(random() % (motion::kHullMaxDepth + 1));
+    const std::uint64_t j = random() % (std::uint64_t{1} << depth);
+    std::uint64_t hull[4] = {whole[0], whole[1], whole[2], whole[3]};
+    for (int bit = depth - 1; bit >= 0; --bit) {
+      motion::internal::KeepHalfOfHull(hull, ((j >> bit) & 1u) != 0);
+    }
+    // The piece in its own parameter, times 8^D: a, 3aj + b·2^D,
+    // 3aj² + 2bj·2^D + c·4^D, aj³ + bj²·2^D + cj·4^D + d·8^D.
+    const Wide a = k[0];
+    const Wide b = k[1];
+    const Wide c = k[2];
+    const Wide d = k[3];
+    const Wide h = Wide{1} << depth;
+    const Wide jj = static_cast<Wide>(j);
+    const Wide pa = a;
+    const Wide pb = 3 * a * jj + b * h;
+    const Wide pc = 3 * a * jj * jj + 2 * b * jj * h + c * h * h;
+    const Wide pd = a * jj * jj * jj + b * jj * jj * h + c * jj * h * h + d * h * h * h;
+    const Wide exact[4] = {3 * pd, 3 * pd + pc, 3 * pd + 2 * pc + pb, 3 * (pa + pb + pc + pd)};
+    const Wide slack = Wide{3} * depth * (h * h * h) / 2;
+    for (int i = 0; i < 4; ++i) {
+      const Wide error = (Wide(hull[i]) - offset) * (h * h * h) - (exact[i] << shift);
+      EXPECT_LE(error, 0) << trial << " coefficient " << i;  // rounded down
+      EXPECT_GE(error, -slack) << trial << " coefficient " << i << " depth " << depth;
+      rounded += error != 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(rounded, 1000);  // the rounding does happen: the bound is not vacuous
+}
+
+// A curve whose peak is exactly at T + 1/2 (it would round to T + 1) is
+// refused, and one 1/64 step below is accepted: the rounded pieces decide the
+// edge as the exact curve does. The peak is at a parameter 15 halvings deep,
+// where the pieces' coefficients are rounded.
+// A PREPARED_CURVE of `power` at the level the planner chooses.
+protocol::Command PreparedAtThePlannersLevel(const PowerCurve1 (&power)[2]) {
+  protocol::Command command;
+  command.type = protocol::MessageType::kPreparedCurve;
+  command.body.prepared_curve = protocol::PreparedCurveCommand{};
+  protocol::PreparedCurveCommand& prepared = command.body.prepared_curve;
+  prepared.dims = 2;
+  prepared.tolerance_q8 = 512;
+  prepared.power[0] = power[0];
+  prepared.power[1] = power[1];
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = prepared.tolerance_q8;
+  PreparedAdaptiveCurve<2> planned;
+  EXPECT_EQ(PrepareAdaptiveCurve(power, settings, &planned), Status::kOk);
+  prepared.level = planned.finest_level;
+  return command;
+}
+
+TEST(ValidateCommand, ACurvePeakingOnTheEdgeIsRefusedDespiteTheRounding) {
+  constexpr std::int32_t kTravel = 16000;
+  const protocol::MachineConfig config = Config(kTravel);
+  // y(u) = M − 3·4^15·(u − 16385/2^15)², x a short line inside.
+  const std::int64_t apex = 16385;
+  for (const std::int64_t below : {std::int64_t{0}, std::int64_t{1024}}) {
+    PowerCurve1 power[2] = {};
+    power[0].c[2] = 100 * 65536;
+    power[0].c[3] = 5000 * 65536;
+    power[1].c[1] = -3 * (std::int64_t{1} << 30);
+    power[1].c[2] = 6 * (std::int64_t{1} << 15) * apex;
+    power[1].c[3] = std::int64_t{kTravel} * 65536 + 32768 - below - 3 * apex * apex;
+    std::uint8_t detail = 0;
+    const protocol::ErrorCode error =
+        motion::ValidateCommand<2>(PreparedAtThePlannersLevel(power), config, &detail);
+    if (below == 0) {
+      EXPECT_EQ(error, protocol::ErrorCode::kOutOfTravel);
+      EXPECT_EQ(detail & 0x7f, 1);
+    } else {
+      EXPECT_EQ(error, protocol::ErrorCode::kNone) << int{detail};
+    }
+  }
+}
+
+// 3000 random cubics moved so that their top is within 3·2^-16 step below
+// T + 1/2 (and as many near −1/2): every one is accepted, within the budget
+// of hull tests. docs/motion.md quotes the most tests one took.
+TEST(ValidateCommand, CurvesGrazingTheEdgeAreAcceptedWithinTheBudget) {
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<long double> unit(0, 1);
+  constexpr std::int32_t kTravel = 16000;
+  const protocol::MachineConfig config = Config(kTravel);
+  std::uint32_t most = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const bool top = trial % 2 == 0;
+    const long double spread = trial % 3 == 0 ? 30 : trial % 3 == 1 ? 3000 : 7000;
+    PowerCurve1 power[2] = {};
+    power[0].c[2] = 100 * 65536;
+    power[0].c[3] = 5000 * 65536;
+    // A Bézier hump (or dip) with its ends 0..1 of spread inside the edge,
+    // at most 2.2 spreads long: inside the travel.
+    long double p[4];
+    for (int i = 0; i < 4; ++i) {
+      const bool inner = i == 1 || i == 2;
+      p[i] = spread * (inner ? 0.2L + unit(random) : -unit(random));
+      if (!top) p[i] = -p[i];
+    }
+    const long double k[4] = {-p[0] + 3 * p[1] - 3 * p[2] + p[3], 3 * p[0] - 6 * p[1] + 3 * p[2],
+                              -3 * p[0] + 3 * p[1], p[0]};
+    for (int i = 0; i < 3; ++i) power[1].c[i] = std::llround(k[i] * 65536);
+    // The extreme of the integer cubic (d = 0), by a dense search refined
+    // around its best sample.
+    PowerCurve1 shape = power[1];
+    long double best_u = 0;
+    long double extreme = 0;
+    for (int step = 0; step <= 4096; ++step) {
+      const long double u = step / 4096.0L;
+      const long double y = Evaluate(shape, u) * (top ? 1 : -1);
+      if (step == 0 || y > extreme) extreme = y, best_u = u;
+    }
+    for (long double width = 1.0L / 4096; width > 1e-12L; width /= 2) {
+      for (const long double u : {best_u - width / 2, best_u + width / 2}) {
+        if (u < 0 || u > 1) continue;
+        const long double y = Evaluate(shape, u) * (top ? 1 : -1);
+        if (y > extreme) extreme = y, best_u = u;
+      }
+    }
+    // Put the extreme 1.5..2.5 units (2^-16 step) inside the edge, rounding
+    // d down (top) or up (bottom) by at most one more unit.
+    const long double inside = (1.5L + unit(random)) / 65536;
+    const long double edge = top ? kTravel + 0.5L : -0.5L;
+    const long double d = top ? edge - extreme - inside : edge + extreme + inside;
+    power[1].c[3] = top ? static_cast<std::int64_t>(std::floor(d * 65536))
+                        : static_cast<std::int64_t>(std::ceil(d * 65536));
+    motion::ValidationWork work{0, 0};
+    std::uint8_t detail = 0;
+    EXPECT_EQ(motion::ValidateCommand<2>(PreparedAtThePlannersLevel(power), config, &detail, &work),
+              protocol::ErrorCode::kNone)
+        << trial << " detail " << int{detail};
+    most = std::max(most, work.hull_tests);
+  }
+  EXPECT_LE(most, motion::kHullTestBudget);
+  RecordProperty("most_hull_tests", static_cast<int>(most));
+  std::printf("3000 grazing curves: at most %u hull tests\n", most);
+}
+
 // Defect 2 of issue 12: a 1025×1025-line frame whose every inner line's hull
 // crosses the travel took seconds, stepping every point. Its validation now
 // has a fixed bound per line, counted here (not timed).

@@ -5,7 +5,6 @@ namespace fdsurf {
 namespace motion {
 namespace {
 
-using internal::Widen;
 using protocol::ErrorCode;
 using protocol::MessageType;
 
@@ -28,72 +27,111 @@ void CopyGeometry(const CurveGeometry1 (&from)[protocol::kMaxAxes], CurveGeometr
 constexpr int64_t kLow3 = -3 * kHalfStep;
 int64_t High3(int32_t travel) { return 3 * (static_cast<int64_t>(travel) * kOneStep + kHalfStep); }
 
-// The cubic A·s³ + B·s² + C·s + D of one piece [j·2^-k, (j+1)·2^-k] of a
-// line's axis, in the piece's own parameter s ∈ [0, 1], in units of
-// 2^-(16+3k) steps: every coefficient is an integer, and every move between
-// neighbouring pieces is additions and exact shifts.
-struct Piece {
-  Int128 a, b, c, d;
-};
-
 enum class Hull : uint8_t { kInside, kOutside, kCrossing };
 
-bool InRange(const Int128& value, const Int128& low3, const Int128& high3) {
-  return low3 <= value && !(high3 <= value);
+// The travel check's numbers (docs/motion.md, "Validation on arrival") are
+// held offset by 2^62 in uint64: every value is below 2^61 in magnitude, so
+// an offset value is in [2^61, 3·2^61), a sum of two does not wrap, and a
+// shift right by one halves the value and the offset alike (both rounded
+// down), with no signed shift.
+constexpr uint64_t kHullOffset = uint64_t{1} << 62;
+constexpr uint64_t kHullLimit = uint64_t{1} << 61;
+
+// 3·b_i, the Bernstein coefficients times 3 (integers): 3d, 3d + c,
+// 3d + 2c + b, 3(a + b + c + d); below 2^53 for coefficients below 2^49.
+void BernsteinTimes3(const int64_t (&k)[4], int64_t (&b3)[4]) {
+  b3[0] = 3 * k[3];
+  b3[1] = b3[0] + k[2];
+  b3[2] = b3[1] + k[2] + k[1];
+  b3[3] = 3 * (k[0] + k[1] + k[2] + k[3]);
 }
 
-// The piece's Bernstein coefficients, times 3: 3D, 3D + C, 3D + 2C + B,
-// 3(A + B + C + D). The first and last are points of the curve: outside
-// means the line leaves the travel.
-Hull Classify(const Piece& p, const Int128& low3, const Int128& high3) {
-  const Int128 d3 = p.d + p.d + p.d;
-  const Int128 sum = p.a + p.b + p.c + p.d;
-  if (!InRange(d3, low3, high3) || !InRange(sum + sum + sum, low3, high3)) return Hull::kOutside;
-  const Int128 h1 = d3 + p.c;
-  return InRange(h1, low3, high3) && InRange(h1 + p.c + p.b, low3, high3) ? Hull::kInside
-                                                                          : Hull::kCrossing;
+uint64_t Magnitude(int64_t value) {
+  return value < 0 ? 0 - static_cast<uint64_t>(value) : static_cast<uint64_t>(value);
 }
 
-// The left half, rescaled: p(s/2)·8 = A, 2B, 4C, 8D.
-void ToLeftHalf(Piece* p) {
-  p->b = internal::ShiftLeft(p->b, 1);
-  p->c = internal::ShiftLeft(p->c, 2);
-  p->d = internal::ShiftLeft(p->d, 3);
+uint64_t Offset(int64_t value, int shift) {
+  return kHullOffset + (static_cast<uint64_t>(value) << shift);  // two's complement: exact
 }
 
-// From a left half to its right neighbour at the same scale: p(s + 1).
-void ToRightNeighbour(Piece* p) {
-  const Int128 a3 = p->a + p->a + p->a;
-  p->d = p->d + p->c + p->b + p->a;
-  p->c = p->c + p->b + p->b + a3;
-  p->b = p->b + a3;
+// The piece's classification against [low3, high3), each of its
+// coefficients within `slack` of the exact one: inside when every exact
+// coefficient is, outside when an end (a point of the curve) is.
+Hull Classify(const uint64_t (&hull)[4], uint64_t low3, uint64_t high3, uint64_t slack) {
+  const auto outside = [&](uint64_t end) { return end + slack < low3 || end >= high3 + slack; };
+  if (outside(hull[0]) || outside(hull[3])) return Hull::kOutside;
+  for (const uint64_t value : hull) {
+    if (value < low3 + slack || value + slack >= high3) return Hull::kCrossing;
+  }
+  return Hull::kInside;
 }
 
-// From a right half back to the whole piece it is half of: p(s − 1) is the
-// left half, and the left half divided back (exactly: it was multiplied).
-void ToParent(Piece* p) {
-  const Int128 a3 = p->a + p->a + p->a;
-  p->d = p->d - p->c + p->b - p->a;
-  p->c = p->c - p->b - p->b + a3;
-  p->b = p->b - a3;
-  p->b = internal::ShiftRightArithmetic(p->b, 1);
-  p->c = internal::ShiftRightArithmetic(p->c, 2);
-  p->d = internal::ShiftRightArithmetic(p->d, 3);
+}  // namespace
+
+namespace internal {
+
+void KeepHalfOfHull(uint64_t (&hull)[4], bool right) {
+  // de Casteljau at s = 1/2; each average rounds down by at most half a unit,
+  // and an average of values within e of theirs is within e + 1/2: the three
+  // rounds leave every coefficient within e + 3/2.
+  const uint64_t m01 = (hull[0] + hull[1]) >> 1;
+  const uint64_t m12 = (hull[1] + hull[2]) >> 1;
+  const uint64_t m23 = (hull[2] + hull[3]) >> 1;
+  const uint64_t m012 = (m01 + m12) >> 1;
+  const uint64_t m123 = (m12 + m23) >> 1;
+  const uint64_t middle = (m012 + m123) >> 1;
+  if (right) {
+    hull[0] = middle;
+    hull[1] = m123;
+    hull[2] = m23;
+  } else {
+    hull[1] = m01;
+    hull[2] = m012;
+    hull[3] = middle;
+  }
 }
+
+int TravelHullOf(const int64_t (&k)[4], int32_t travel, uint64_t (&hull)[4], uint64_t* low3,
+                 uint64_t* high3) {
+  int64_t b3[4];
+  BernsteinTimes3(k, b3);
+  const int64_t ends[2] = {kLow3, High3(travel)};
+  uint64_t largest = 0;
+  for (const int64_t value : b3) largest |= Magnitude(value);
+  for (const int64_t value : ends) largest |= Magnitude(value);
+  int shift = 0;
+  while ((largest << 1) < kHullLimit) {  // as many fraction bits as fit
+    largest <<= 1;
+    ++shift;
+  }
+  for (int i = 0; i < 4; ++i) hull[i] = Offset(b3[i], shift);
+  *low3 = Offset(ends[0], shift);
+  *high3 = Offset(ends[1], shift);
+  return shift;
+}
+
+}  // namespace internal
+
+namespace {
 
 // Whether the cubic a·u³ + b·u² + c·u + d (2^-16 steps) stays in
-// [−1/2, T + 1/2) for u ∈ [0, 1]: pieces whose hull crosses the boundary are
-// halved, depth first, in exact integers, until every hull is inside
-// (accepted) or a curve point is outside (refused: exact). A piece still
-// crossing at kHullMaxDepth, or a line needing more than kHullTestBudget
-// tests, is refused too (*undecided): never accepted unless proven inside.
-// Coefficients below 2^49 times 8^20 stay below 2^113: no overflow.
+// [−1/2, T + 1/2) for u ∈ [0, 1]. Pieces are taken left to right; one whose
+// hull crosses the boundary is halved, one whose hull is inside is done, and
+// one whose end (a point of the curve) is outside refuses the line. A piece
+// is formed from the whole line by its halvings, rounded down, so each
+// coefficient at depth k is within 3k/2 units of the exact one (at most 30
+// units of 2^-(16+shift)/3 step, shift ≥ 7): the tests allow that much, so
+// nothing is accepted that leaves the travel. A piece still crossing at
+// kHullMaxDepth, or a line needing more than kHullTestBudget tests, is
+// refused too (*undecided). 64-bit: no wide integers, O(1) memory.
 bool AxisWithinTravel(const int64_t (&k)[4], int32_t travel, ValidationWork* work,
                       bool* undecided) {
-  Piece p{Widen(k[0]), Widen(k[1]), Widen(k[2]), Widen(k[3])};
-  Int128 low3 = Widen(kLow3);
-  Int128 high3 = Widen(High3(travel));
-  uint32_t j = 0;
+  uint64_t whole[4];
+  uint64_t low3 = 0;
+  uint64_t high3 = 0;
+  internal::TravelHullOf(k, travel, whole, &low3, &high3);
+  uint64_t hull[4] = {whole[0], whole[1], whole[2], whole[3]};
+  uint32_t j = 0;  // the piece [j·2^-depth, (j + 1)·2^-depth]
   int depth = 0;
   for (uint16_t tests = 0;; ++tests) {
     if (tests == kHullTestBudget) {
@@ -101,30 +139,27 @@ bool AxisWithinTravel(const int64_t (&k)[4], int32_t travel, ValidationWork* wor
       return false;
     }
     if (work != nullptr) ++work->hull_tests;
-    const Hull hull = Classify(p, low3, high3);
-    if (hull == Hull::kOutside) return false;
-    if (hull == Hull::kCrossing) {
+    const Hull verdict = Classify(hull, low3, high3, (3u * depth + 1) / 2);
+    if (verdict == Hull::kOutside) return false;
+    if (verdict == Hull::kCrossing) {
       if (depth == kHullMaxDepth) {
         *undecided = true;
         return false;
       }
-      ToLeftHalf(&p);
-      low3 = internal::ShiftLeft(low3, 3);
-      high3 = internal::ShiftLeft(high3, 3);
+      internal::KeepHalfOfHull(hull, false);
       ++depth;
       j <<= 1;
       continue;
     }
-    while ((j & 1u) != 0) {  // a right half is done: so is its parent
-      ToParent(&p);
-      low3 = internal::ShiftRightArithmetic(low3, 3);
-      high3 = internal::ShiftRightArithmetic(high3, 3);
-      --depth;
+    ++j;  // the next piece: up while it is the right end of its parent
+    while (depth > 0 && (j & 1u) == 0) {
       j >>= 1;
+      --depth;
     }
     if (depth == 0) return true;
-    ToRightNeighbour(&p);
-    ++j;
+    for (int i = 0; i < 4; ++i) hull[i] = whole[i];
+    for (int bit = depth - 1; bit >= 0; --bit)
+      internal::KeepHalfOfHull(hull, ((j >> bit) & 1u) != 0);
   }
 }
 
@@ -140,8 +175,8 @@ bool WithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel, uint
                   ValidationWork* work) {
   for (int c = 0; c < kDims; ++c) {
     const int64_t(&k)[4] = curve[c].c;
-    const int64_t hull[4] = {3 * k[3], 3 * k[3] + k[2], 3 * k[3] + 2 * k[2] + k[1],
-                             3 * (k[0] + k[1] + k[2] + k[3])};
+    int64_t hull[4];
+    BernsteinTimes3(k, hull);
     bool crossing = false;
     for (const int64_t value : hull)
       crossing = crossing || value < kLow3 || value >= High3(travel[c]);

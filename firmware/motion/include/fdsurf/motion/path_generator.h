@@ -41,6 +41,23 @@ constexpr int kHullMaxDepth = 20;
 constexpr uint16_t kHullTestBudget = 64;
 constexpr uint8_t kUndecidedTravel = 0x80;
 
+namespace internal {
+
+/// The travel check's whole line, for one axis a·u³ + b·u² + c·u + d
+/// (2^-16 steps, |coefficients| < 2^49) and travel T (≤ 2^26 steps): its
+/// Bernstein coefficients times 3 and the ends 3·(−1/2), 3·(T + 1/2), each
+/// times 2^shift and offset by 2^62 in uint64 (docs/motion.md, "Validation
+/// on arrival"). Returns shift, the most that keeps every value below 2^60.
+int TravelHullOf(const int64_t (&k)[4], int32_t travel, uint64_t (&hull)[4], uint64_t* low3,
+                 uint64_t* high3);
+
+/// One de Casteljau halving of an offset hull: keeps the right half or the
+/// left. Each average is rounded down, so a coefficient within e units of
+/// the exact one's is within e + 3/2 of the half's.
+void KeepHalfOfHull(uint64_t (&hull)[4], bool right);
+
+}  // namespace internal
+
 /// "The device's planner chooses the level" where a level may come from the
 /// host (PREPARED_CURVE).
 constexpr int8_t kPlannerLevel = -1;
