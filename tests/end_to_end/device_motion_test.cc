@@ -622,7 +622,7 @@ TEST(ValidateCommand, TheTravelCheckIsSoundAndNearlyExact) {
 // 8^D, so that they are integers) for random lines up to the largest travel.
 TEST(ValidateCommand, TheTravelHullIsWithinItsSlackOfTheExactPiece) {
   std::mt19937_64 random(31);
-  using Wide = __int128;
+  __extension__ using Wide = __int128;
   int rounded = 0;
   for (int trial = 0; trial < 4000; ++trial) {
     const int bits = 4 + static_cast<int>(random() % 44);  // coefficients up to 2^47
