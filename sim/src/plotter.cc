@@ -111,15 +111,19 @@ class SimulatedPlotter::FaultyTransport final : public hal::Transport {
 // less its 3 hull tests.
 constexpr std::uint32_t kAvrCyclesPerLine = 425039;
 constexpr std::uint32_t kAvrCyclesPerHullTest = 5062;
+// validate-prepared: the same line as a PREPARED_CURVE, no hull test.
+constexpr std::uint32_t kAvrCyclesPerPreparedLine = 43014;
 
 DeviceCost DeviceCost::Atmega2560() {
-  return DeviceCost{16'000'000, kAvrCyclesPerLine, kAvrCyclesPerHullTest};
+  return DeviceCost{16'000'000, kAvrCyclesPerLine, kAvrCyclesPerHullTest,
+                    kAvrCyclesPerPreparedLine};
 }
 
 std::uint64_t DeviceCost::Microseconds(const motion::ValidationWork& work) const {
   if (cpu_hz == 0) return 0;
   const std::uint64_t cycles = std::uint64_t{work.lines} * cycles_per_line +
-                               std::uint64_t{work.hull_tests} * cycles_per_hull_test;
+                               std::uint64_t{work.hull_tests} * cycles_per_hull_test +
+                               std::uint64_t{work.prepared_lines} * cycles_per_prepared_line;
   return (cycles * 1'000'000 + cpu_hz - 1) / cpu_hz;
 }
 
@@ -251,9 +255,12 @@ RunResult SimulatedPlotter::Run(host::HostLink& link, std::uint64_t time_limit_u
         device_down = runner_->Service(*device_end_) == hal::IoStatus::kDisconnected;
         const motion::ValidationWork work = runner_->validation_work();
         const motion::ValidationWork spent{work.lines - charged.lines,
-                                           work.hull_tests - charged.hull_tests};
+                                           work.hull_tests - charged.hull_tests,
+                                           work.prepared_lines - charged.prepared_lines};
         charged = work;
-        busy_until = now + options_.device_cost.Microseconds(spent);
+        const std::uint64_t busy_us = options_.device_cost.Microseconds(spent);
+        result.validation_us += busy_us;
+        busy_until = now + busy_us;
         if (busy_until == now && device_end_->Release() == hal::IoStatus::kDisconnected) {
           device_down = true;
         }

@@ -344,14 +344,14 @@ protocol::MachineConfig g_validate_config;
 protocol::Command g_validate_command;
 
 __attribute__((noinline)) void BenchValidateOne(const char* name) {
-  motion::ValidationWork work = {0, 0};
+  motion::ValidationWork work = {0, 0, 0};
   uint8_t detail = 0;
   PortMark();
   const protocol::ErrorCode error =
       motion::ValidateCommand<2>(g_validate_command, g_validate_config, &detail, &work);
   PortMark();
   if (error != protocol::ErrorCode::kNone) PortExit(5);
-  PutBenchLine(name, 2, work.lines, work.hull_tests);
+  PutBenchLine(name, 2, work.lines + work.prepared_lines, work.hull_tests);
 }
 
 __attribute__((noinline)) void BenchValidate() {

@@ -311,6 +311,8 @@ TEST_F(Cli, StreamChargesTheDevicesComputeTimeOnRequest) {
   ASSERT_EQ(mega.exit_code, 0) << mega.err;
   EXPECT_EQ(mega.err.find(" 0 timeouts"), std::string::npos) << mega.err;
   EXPECT_NE(mega.err.find("(--tolerance): within"), std::string::npos) << mega.err;
+  EXPECT_NE(mega.err.find("of its main loop validating commands"), std::string::npos) << mega.err;
+  EXPECT_EQ(free.err.find("of its main loop validating commands"), std::string::npos) << free.err;
 }
 
 TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {

@@ -767,7 +767,7 @@ TEST(ValidateCommand, CurvesGrazingTheEdgeAreAcceptedWithinTheBudget) {
     const long double d = top ? edge - extreme - inside : edge + extreme + inside;
     power[1].c[3] = top ? static_cast<std::int64_t>(std::floor(d * 65536))
                         : static_cast<std::int64_t>(std::ceil(d * 65536));
-    motion::ValidationWork work{0, 0};
+    motion::ValidationWork work{0, 0, 0};
     std::uint8_t detail = 0;
     EXPECT_EQ(motion::ValidateCommand<2>(PreparedAtThePlannersLevel(power), config, &detail, &work),
               protocol::ErrorCode::kNone)
@@ -794,7 +794,7 @@ TEST(ValidateCommand, AFrameOf1025LinesValidatesWithinItsBudget) {
     }
   }
   const protocol::MachineConfig config = Config(16000);
-  motion::ValidationWork work{0, 0};
+  motion::ValidationWork work{0, 0, 0};
   std::uint8_t detail = 0;
   EXPECT_EQ(motion::ValidateCommand<2>(patch, config, &detail, &work), protocol::ErrorCode::kNone)
       << int{detail};

@@ -271,7 +271,7 @@ TEST(SimulatedPlotter, ChargesTheDevicesComputeTime) {
   ASSERT_TRUE(free.finished) << free.error;
   EXPECT_EQ(free.host.timeouts, 0u);
   const DeviceCost avr = DeviceCost::Atmega2560();
-  const std::uint64_t busy_us = avr.Microseconds(motion::ValidationWork{2050, 3 * 2050});
+  const std::uint64_t busy_us = avr.Microseconds(motion::ValidationWork{2050, 3 * 2050, 0});
   EXPECT_GT(busy_us, 1'000'000u);  // seconds on the Mega
   const RunResult slow = run(avr);
   EXPECT_GT(slow.host.timeouts, 0u);
@@ -405,6 +405,33 @@ TEST(SimulatedPlotter, DrawsTheSameWhenTheHostPlansTheLines) {
     ASSERT_EQ(run.drawn[k].points, Baseline().drawn[k].points) << "stroke " << k;
   }
   EXPECT_EQ(run.pens.size(), Baseline().pens.size());
+}
+
+// The cost model charges a prepared line the check at its level (43,014
+// cycles on the ATmega2560), not the planner's search (425,039): the small
+// teapot as PREPARED_CURVEs keeps the Mega's main loop validating for a
+// fraction of the time its patches do.
+TEST(SimulatedPlotter, ChargesAPreparedLineTheCheckAtItsLevel) {
+  PlotterOptions options;
+  options.device_cost = DeviceCost::Atmega2560();
+  const host::StreamJob patches = SmallTeapotJob();
+  host::StreamJob prepared = patches;
+  host::PrepareOnHost(&prepared);
+  std::uint64_t lines = 0;
+  for (const protocol::Command& command : prepared.commands) {
+    if (command.type == protocol::MessageType::kPreparedCurve) ++lines;
+  }
+  const Streamed as_patches = Stream(patches, options);
+  const Streamed as_prepared = Stream(prepared, options);
+  ASSERT_TRUE(as_patches.result.finished) << as_patches.result.error;
+  ASSERT_TRUE(as_prepared.result.finished) << as_prepared.result.error;
+  EXPECT_GE(as_prepared.result.validation_us, lines * 43014 / 16);
+  EXPECT_GE(as_patches.result.validation_us, lines * 425039 / 16 * 9 / 10);
+  EXPECT_LT(as_prepared.result.validation_us, as_patches.result.validation_us / 4);
+  std::printf("validation on the Mega: %llu ms as patches, %llu ms as %llu prepared lines\n",
+              static_cast<unsigned long long>(as_patches.result.validation_us / 1000),
+              static_cast<unsigned long long>(as_prepared.result.validation_us / 1000),
+              static_cast<unsigned long long>(lines));
 }
 
 // The device checks the level it is given: one below the planner's, a curve

@@ -216,7 +216,7 @@ template <int kDims>
 ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
                     const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
   PreparedAdaptiveCurve<kDims> prepared;
-  if (work != nullptr) ++work->lines;
+  if (work != nullptr) ++(host_level < 0 ? work->lines : work->prepared_lines);
   const Status status = PrepareLine(curve, tolerance_q8, host_level, &prepared);
   if (status != Status::kOk) {
     *detail = static_cast<uint8_t>(status);

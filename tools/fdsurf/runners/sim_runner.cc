@@ -300,6 +300,11 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
                static_cast<unsigned long long>(run.host.bytes_sent),
                static_cast<unsigned long long>(run.host.naks),
                static_cast<unsigned long long>(run.host.timeouts), run.acknowledged_us * 1e-6);
+  if (o.sim_cost == "atmega2560") {
+    std::fprintf(stderr,
+                 "device: %.2f s of its main loop validating commands (--sim-cost atmega2560)\n",
+                 run.validation_us * 1e-6);
+  }
   std::fprintf(stderr,
                "wire: %zu bytes of command frames vs %zu bytes of G-code for the same drawing at "
                "the same tolerance (%.1fx smaller)\n",

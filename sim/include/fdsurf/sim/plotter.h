@@ -33,8 +33,9 @@ class DeviceRunner;  // the firmware Device for 2 or 3 axes
 /// default): computing is free, as on a fast host.
 struct DeviceCost {
   std::uint32_t cpu_hz = 0;
-  std::uint32_t cycles_per_line = 0;       // planner and hull test of one line
-  std::uint32_t cycles_per_hull_test = 0;  // each halving's hull test
+  std::uint32_t cycles_per_line = 0;           // the planner on one line
+  std::uint32_t cycles_per_hull_test = 0;      // each halving's hull test
+  std::uint32_t cycles_per_prepared_line = 0;  // a PREPARED_CURVE's check at its level
   /// An ATmega2560 at 16 MHz, as measured under simavr (docs/motion.md).
   static DeviceCost Atmega2560();
   FDSURF_NODISCARD std::uint64_t Microseconds(const motion::ValidationWork& work) const;
@@ -77,6 +78,9 @@ struct RunResult {
   /// When the device had acknowledged every command (virtual time).
   std::uint64_t acknowledged_us = 0;
   std::uint64_t executed = 0;
+  /// How long the device's main loop spent validating, by the device cost
+  /// model (0 when it is free).
+  std::uint64_t validation_us = 0;
   host::HostLinkStats host;
   protocol::DeviceLinkStats device;
   protocol::FrameDecoderStats device_frames;

@@ -904,7 +904,7 @@ class Device {
   protocol::ErrorCode error_;
   uint8_t error_detail_;
   uint32_t executed_;
-  motion::ValidationWork validation_work_ = {0, 0};
+  motion::ValidationWork validation_work_ = {0, 0, 0};
   PausePhase pause_ = PausePhase::kNone;
   uint32_t pause_wait_ = 0;           // pen delay ticks left in kLifting/kLowering
   bool pen_lifted_by_pause_ = false;  // the pen is up only because of the pause

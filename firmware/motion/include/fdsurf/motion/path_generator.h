@@ -63,10 +63,13 @@ void KeepHalfOfHull(uint64_t (&hull)[4], bool right);
 constexpr int8_t kPlannerLevel = -1;
 
 /// Work done by ValidateCommand, counted for tests and cost models: lines
-/// put through the planner, and hull tests of the travel check's halving.
+/// put through the planner, hull tests of the travel check's halving, and
+/// lines whose level the host chose (PREPARED_CURVE: checked at that level,
+/// several times cheaper than the planner's search).
 struct ValidationWork {
   uint32_t lines;
   uint32_t hull_tests;
+  uint32_t prepared_lines;
 };
 
 /// The finest level of a straight move `line` (c[0] = c[1] = 0): the
