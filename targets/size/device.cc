@@ -73,7 +73,10 @@ class PortOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
   const char* DoLastError() const override { return ""; }
 };
 
-device::Device<2, 4, 256> g_device(40000);
+#ifndef FDSURF_SIZE_DEVICE_FRAME_BYTES
+#define FDSURF_SIZE_DEVICE_FRAME_BYTES protocol::kMaxFrameBytes
+#endif
+device::Device<2, 4, 256, device::SingleThreadLock, FDSURF_SIZE_DEVICE_FRAME_BYTES> g_device(40000);
 UartTransport g_transport;
 PortOutputs g_outputs;
 

@@ -214,6 +214,46 @@ TEST(Codec, CommandRoundTrips) {
 
 // HOME is axes u8, toward_max u8, rate u32, backoff u32 (10 bytes); MOTORS
 // one byte; CONFIG's flags byte is its last (after the servo widths).
+// The largest frame of each command a device without the planner takes,
+// every field at its widest: all fit kMaxPreparedFrameBytes, the size such a
+// device may give its frame buffer, and the largest is a 3-D PREPARED_CURVE.
+TEST(Codec, EveryCommandButPatchAndCurveFitsTheSmallFrame) {
+  constexpr int64_t kWidest = -((int64_t{1} << 47) - 1);  // zigzag 2^48 - 3: 7 bytes
+  Command prepared = Prepared(3);
+  prepared.body.prepared_curve.level = 30;
+  prepared.body.prepared_curve.tolerance_q8 = UINT32_MAX;
+  for (PowerCurve1& axis : prepared.body.prepared_curve.power) {
+    for (int64_t& value : axis.c) value = kWidest;
+  }
+  Command config = Config();
+  MachineConfig& machine = config.body.config;
+  machine.axes = 3;
+  for (int a = 0; a < kMaxAxes; ++a) {
+    machine.steps_per_meter[a] = UINT32_MAX;
+    machine.travel_steps[a] = INT32_MIN;
+    machine.axis_accel[a] = UINT32_MAX;
+  }
+  machine.max_rate = machine.accel = machine.travel_rate = UINT32_MAX;
+  machine.pen_delay_ms = machine.servo_up_us = machine.servo_down_us = UINT16_MAX;
+  machine.flags = 0xff;
+  const Command widest[] = {prepared,
+                            config,
+                            Move(INT32_MIN, INT32_MIN, INT32_MIN),
+                            Pen(true),
+                            Home(0xff, 0xff, UINT32_MAX, UINT32_MAX),
+                            Motors(true)};
+  size_t largest = 0;
+  for (const Command& command : widest) {
+    const size_t frame = CommandBody(command).size() + kFrameOverheadBytes;
+    EXPECT_LE(frame, kMaxPreparedFrameBytes) << static_cast<int>(command.type);
+    largest = std::max(largest, frame);
+  }
+  EXPECT_EQ(CommandBody(prepared).size() + kFrameOverheadBytes, largest);
+  EXPECT_EQ(largest, 97u);  // messages.h derives it
+  std::printf("largest frames: PREPARED_CURVE %zu, CONFIG %zu bytes\n", largest,
+              CommandBody(config).size() + kFrameOverheadBytes);
+}
+
 TEST(Codec, HomeMotorsAndFlagsBodies) {
   EXPECT_EQ(CommandBody(Home(0x03, 0x02, 0x01020304u, 0x0A0B0C0Du)),
             (Bytes{0x03, 0x02, 0x04, 0x03, 0x02, 0x01, 0x0D, 0x0C, 0x0B, 0x0A}));

@@ -79,13 +79,19 @@ struct SingleThreadLock {
 /// that can wait (the host's credit). kLookahead: unit moves and events
 /// buffered ahead of the motion, a power of two; the loop reaches full speed
 /// only if the buffer holds the braking distance (docs/motion.md).
-/// InterruptLock: see the top of this file.
+/// InterruptLock: see the top of this file. kFrameBytes: the largest decoded
+/// frame taken, protocol::kMaxFrameBytes, or protocol::kMaxPreparedFrameBytes
+/// on a device built without the planner (FDSURF_DEVICE_PLANNER=0) that
+/// must save RAM.
 template <int kAxes, int kQueueCapacity = 8, int kLookahead = 1024,
-          class InterruptLock = SingleThreadLock>
+          class InterruptLock = SingleThreadLock, size_t kFrameBytes = protocol::kMaxFrameBytes>
 class Device {
  public:
   static_assert(kAxes == 2 || kAxes == 3, "2 or 3 axes");
   static_assert(kQueueCapacity >= 1 && kQueueCapacity <= 255, "1..255 queued commands");
+  static_assert(kFrameBytes >= protocol::kMaxPreparedFrameBytes &&
+                    kFrameBytes <= protocol::kMaxFrameBytes,
+                "frames of kMaxPreparedFrameBytes (no planner) to kMaxFrameBytes");
   static_assert(kLookahead >= 2 && kLookahead <= 32768 && (kLookahead & (kLookahead - 1)) == 0,
                 "the lookahead is a power of two");
 
@@ -884,7 +890,7 @@ class Device {
   enum class PausePhase : uint8_t { kNone, kBraking, kLifting, kHeld, kLowering };
 
   uint32_t tick_hz_;
-  protocol::DeviceLink<Device> link_;
+  protocol::DeviceLink<Device, 256, kFrameBytes> link_;
   uint8_t lookahead_[kLookahead];
   motion::MotionLoop motion_;
   motion::PathGenerator<kAxes> generator_;

@@ -42,6 +42,15 @@ namespace protocol {
 constexpr uint8_t kProtocolVersion = 4;
 /// Largest decoded frame: type, sequence number, body and CRC together.
 constexpr size_t kMaxFrameBytes = 512;
+/// Largest decoded frame of the commands a device without the planner takes
+/// (every type but PATCH and CURVE). The largest is a 3-D PREPARED_CURVE:
+/// 7 bytes of frame, dims and level (2), the tolerance (4) and 12
+/// coefficients below 2^47 (at most 7 zigzag varint bytes each), 97 bytes; a
+/// CONFIG is at most 63 (codec_test's EveryCommandButPatchAndCurveFitsTheSmallFrame).
+/// Such a device may size its frame buffer to this (device::Device's
+/// kFrameBytes) and save 412 bytes of RAM; a PATCH sent to it is then
+/// dropped as overlong instead of refused as an unknown type.
+constexpr size_t kMaxPreparedFrameBytes = 100;
 /// Largest number of axes a device drives (X, Y and optionally Z).
 constexpr int kMaxAxes = 3;
 
