@@ -636,7 +636,7 @@ TEST(ValidateCommand, TheTravelHullIsWithinItsSlackOfTheExactPiece) {
     std::uint64_t low3 = 0;
     std::uint64_t high3 = 0;
     const int shift = motion::internal::TravelHullOf(k, travel, whole, &low3, &high3);
-    ASSERT_GE(shift, 7);
+    ASSERT_GE(shift, 8);
     const Wide offset = Wide{1} << 62;
     EXPECT_EQ(Wide(low3) - offset, Wide{-3 * 32768} << shift);
     EXPECT_EQ(Wide(high3) - offset, (Wide{3} * (Wide{travel} * 65536 + 32768)) << shift);

@@ -120,7 +120,7 @@ namespace {
 // one whose end (a point of the curve) is outside refuses the line. A piece
 // is formed from the whole line by its halvings, rounded down, so each
 // coefficient at depth k is within 3k/2 units of the exact one (at most 30
-// units of 2^-(16+shift)/3 step, shift ≥ 7): the tests allow that much, so
+// units of 2^-(16+shift)/3 step, shift ≥ 8): the tests allow that much, so
 // nothing is accepted that leaves the travel. A piece still crossing at
 // kHullMaxDepth, or a line needing more than kHullTestBudget tests, is
 // refused too (*undecided). 64-bit: no wide integers, O(1) memory.

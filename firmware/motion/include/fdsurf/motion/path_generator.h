@@ -47,7 +47,8 @@ namespace internal {
 /// (2^-16 steps, |coefficients| < 2^49) and travel T (≤ 2^26 steps): its
 /// Bernstein coefficients times 3 and the ends 3·(−1/2), 3·(T + 1/2), each
 /// times 2^shift and offset by 2^62 in uint64 (docs/motion.md, "Validation
-/// on arrival"). Returns shift, the most that keeps every value below 2^60.
+/// on arrival"). Returns shift, the most that keeps the values' bitwise OR
+/// (so each magnitude) below 2^61; at least 8.
 int TravelHullOf(const int64_t (&k)[4], int32_t travel, uint64_t (&hull)[4], uint64_t* low3,
                  uint64_t* high3);
 
