@@ -426,6 +426,55 @@ TEST(DeviceLink, HelloResumeKeepsStateAndVersionMismatchIsRefused) {
 // Protocol version 2: frames of another session (or of none) are neither
 // executed nor answered; a resume of a session the device does not have is
 // refused; session 0 is not a session.
+// A device without the planner may take frames of kMaxPreparedFrameBytes
+// (messages.h, device::Device's kFrameBytes): the widest PREPARED_CURVE, 3-D
+// with every field at its widest, passes through such a link intact, and a
+// PATCH is dropped as overlong, unanswered and not accepted.
+TEST(DeviceLink, TheSmallFrameTakesTheWidestPreparedCurveAndDropsAPatch) {
+  FakeSink sink;
+  DeviceLink<FakeSink, 256, kMaxPreparedFrameBytes> device(&sink);
+  const auto send = [&device](const Bytes& wire) {
+    for (uint8_t b : wire) device.OnByte(b);
+    Bytes out(4096);
+    out.resize(device.ReadOutput(out.data(), out.size()));
+    std::vector<Reply> replies;
+    FrameDecoderBuffer<> decoder;
+    decoder.set_session(kTestSession);
+    for (uint8_t b : out) {
+      if (!decoder.OnByte(b)) continue;
+      Reply r;
+      EXPECT_TRUE(DecodeReply(decoder.frame(), &r).ok());
+      replies.push_back(r);
+    }
+    return replies;
+  };
+  ASSERT_EQ(send(HelloWire(1, kHelloFlagNewSession)).size(), 1u);
+  Command prepared;
+  prepared.type = MessageType::kPreparedCurve;
+  prepared.seq = 0;
+  prepared.body.prepared_curve = PreparedCurveCommand{};
+  PreparedCurveCommand& curve = prepared.body.prepared_curve;
+  curve.dims = 3;
+  curve.level = 30;
+  curve.tolerance_q8 = UINT32_MAX;
+  for (PowerCurve1& axis : curve.power) {
+    for (int64_t& value : axis.c) value = -((int64_t{1} << 47) - 1);
+  }
+  std::vector<Reply> replies = send(WireOf(prepared, 0));
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].type, MessageType::kAck);
+  ASSERT_EQ(sink.accepted.size(), 1u);
+  EXPECT_EQ(BodyOf(sink.accepted[0]), BodyOf(prepared));
+  EXPECT_EQ(device.frame_stats().overlong, 0u);
+
+  const Command patch = JobCommand(3);
+  ASSERT_EQ(patch.type, MessageType::kPatch);
+  replies = send(WireOf(patch, 1));
+  EXPECT_TRUE(replies.empty());
+  EXPECT_EQ(device.frame_stats().overlong, 1u);
+  EXPECT_EQ(sink.accepted.size(), 1u);
+}
+
 TEST(DeviceLink, FramesOfAnotherSessionAreDroppedUnanswered) {
   DirectDevice d;
   EXPECT_TRUE(d.Send(WireOf(JobCommand(0), 0)).empty()) << "no session yet";
