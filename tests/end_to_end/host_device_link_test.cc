@@ -245,29 +245,33 @@ void ExpectExactlyOnceInOrder(const FakeSink& sink, uint32_t count, bool small_o
 // The session of the hand-made frames below.
 constexpr uint32_t kTestSession = 0x5E55'1011;
 
+// Feeds `wire` to a DeviceLink and decodes its replies with `session`'s tag.
+template <typename Link>
+std::vector<Reply> SendTo(Link& device, const Bytes& wire, uint32_t session) {
+  for (uint8_t b : wire) {
+    device.OnByte(b);
+  }
+  Bytes out(4096);
+  out.resize(device.ReadOutput(out.data(), out.size()));
+  std::vector<Reply> replies;
+  FrameDecoderBuffer<> decoder;
+  decoder.set_session(session);
+  for (uint8_t b : out) {
+    if (decoder.OnByte(b)) {
+      Reply r;
+      EXPECT_TRUE(DecodeReply(decoder.frame(), &r).ok());
+      replies.push_back(r);
+    }
+  }
+  return replies;
+}
+
 struct DirectDevice {
   FakeSink sink;
   Device device{&sink};
   uint32_t session = kTestSession;  // the replies' decoder takes this session's tag
 
-  std::vector<Reply> Send(const Bytes& wire) {
-    for (uint8_t b : wire) {
-      device.OnByte(b);
-    }
-    Bytes out(4096);
-    out.resize(device.ReadOutput(out.data(), out.size()));
-    std::vector<Reply> replies;
-    FrameDecoderBuffer<> decoder;
-    decoder.set_session(session);
-    for (uint8_t b : out) {
-      if (decoder.OnByte(b)) {
-        Reply r;
-        EXPECT_TRUE(DecodeReply(decoder.frame(), &r).ok());
-        replies.push_back(r);
-      }
-    }
-    return replies;
-  }
+  std::vector<Reply> Send(const Bytes& wire) { return SendTo(device, wire, session); }
   Reply SendOne(const Bytes& wire) {
     const std::vector<Reply> replies = Send(wire);
     EXPECT_EQ(replies.size(), 1u);
@@ -433,21 +437,7 @@ TEST(DeviceLink, HelloResumeKeepsStateAndVersionMismatchIsRefused) {
 TEST(DeviceLink, TheSmallFrameTakesTheWidestPreparedCurveAndDropsAPatch) {
   FakeSink sink;
   DeviceLink<FakeSink, 256, kMaxPreparedFrameBytes> device(&sink);
-  const auto send = [&device](const Bytes& wire) {
-    for (uint8_t b : wire) device.OnByte(b);
-    Bytes out(4096);
-    out.resize(device.ReadOutput(out.data(), out.size()));
-    std::vector<Reply> replies;
-    FrameDecoderBuffer<> decoder;
-    decoder.set_session(kTestSession);
-    for (uint8_t b : out) {
-      if (!decoder.OnByte(b)) continue;
-      Reply r;
-      EXPECT_TRUE(DecodeReply(decoder.frame(), &r).ok());
-      replies.push_back(r);
-    }
-    return replies;
-  };
+  const auto send = [&device](const Bytes& wire) { return SendTo(device, wire, kTestSession); };
   ASSERT_EQ(send(HelloWire(1, kHelloFlagNewSession)).size(), 1u);
   Command prepared;
   prepared.type = MessageType::kPreparedCurve;
