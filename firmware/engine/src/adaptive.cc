@@ -29,10 +29,6 @@ int64_t ChordBudget16(uint32_t tolerance_q8, int dims) {
          kPreStepAllowance16;
 }
 
-uint64_t Magnitude(int64_t v) {
-  return v < 0 ? ~static_cast<uint64_t>(v) + 1 : static_cast<uint64_t>(v);
-}
-
 // round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
 // floor((2|x| + ab) / 2ab) by successive floor divisions, which compose.
 int64_t RoundedQuotient(const internal::WideInt<4>& x, uint32_t a, uint32_t b) {
@@ -56,7 +52,7 @@ Status CoefficientMagnitudes(const PowerCurve1 (&curve)[kDims], uint64_t (&m)[kD
     uint64_t sum = 0;
     for (int k = 0; k < 4; ++k) {
       if (!GeometryInRange(curve[c].c[k])) return Status::kGeometryOutOfRange;
-      m[c][k] = Magnitude(curve[c].c[k]);
+      m[c][k] = internal::Magnitude(curve[c].c[k]);
       sum += m[c][k];
     }
     if (sum + (uint64_t{1} << 15) >= static_cast<uint64_t>(kGeometryLimitRaw)) {

@@ -46,10 +46,6 @@ void BernsteinTimes3(const int64_t (&k)[4], int64_t (&b3)[4]) {
   b3[3] = 3 * (k[0] + k[1] + k[2] + k[3]);
 }
 
-uint64_t Magnitude(int64_t value) {
-  return value < 0 ? 0 - static_cast<uint64_t>(value) : static_cast<uint64_t>(value);
-}
-
 uint64_t Offset(int64_t value, int shift) {
   return kHullOffset + (static_cast<uint64_t>(value) << shift);  // two's complement: exact
 }
@@ -97,8 +93,8 @@ int TravelHullOf(const int64_t (&k)[4], int32_t travel, uint64_t (&hull)[4], uin
   BernsteinTimes3(k, b3);
   const int64_t ends[2] = {kLow3, High3(travel)};
   uint64_t largest = 0;
-  for (const int64_t value : b3) largest |= Magnitude(value);
-  for (const int64_t value : ends) largest |= Magnitude(value);
+  for (const int64_t value : b3) largest |= fdsurf::internal::Magnitude(value);
+  for (const int64_t value : ends) largest |= fdsurf::internal::Magnitude(value);
   int shift = 0;
   while ((largest << 1) < kHullLimit) {  // as many fraction bits as fit
     largest <<= 1;

@@ -67,6 +67,11 @@ inline Int128 Widen(int64_t value) {
   return Int128{static_cast<uint64_t>(value), value < 0 ? ~uint64_t{0} : uint64_t{0}};
 }
 
+/// |value| as uint64_t, exact for every value (INT64_MIN included).
+inline uint64_t Magnitude(int64_t value) {
+  return value < 0 ? 0 - static_cast<uint64_t>(value) : static_cast<uint64_t>(value);
+}
+
 /// Two's complement reinterpretation, well defined for every value.
 inline int32_t ToInt32(uint32_t bits) {
   return bits <= 0x7FFFFFFFu ? static_cast<int32_t>(bits) : -static_cast<int32_t>(~bits) - 1;
