@@ -209,6 +209,45 @@ Status PrepareAtLevel(const PowerCurve1 (&curve)[kDims], const uint64_t (&m)[kDi
   return Status::kOk;
 }
 
+// AxisFitsLevel for the 64-bit accumulator only, in uint64_t: the same
+// tests, so that it accepts exactly what AxisFitsLevel accepts with fits64
+// still set. Every value formed stays below 2^63: 8·S < 2^55 is shifted by
+// 3L only once it is known to stay below 2^62 (and F ≤ 62 makes 3L ≤ 46),
+// B = 8·S·2^(3L) + 2^F < 2^63 then, and (6|a| + 2|b|)·2^L + 6|a| ≤ 8·S·2^(3L).
+// A chord limit of 2^62 or more exceeds every value a table below 2^62 has,
+// so its test passes (ChordLimit clamps it there too).
+FDSURF_OUT_OF_LINE_ON_AVR Status AxisFitsLevel64(const uint64_t (&m)[4], int level,
+                                                 int64_t budget16, bool step_exact) {
+  constexpr uint64_t kLimit = uint64_t{1} << 62;
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+  if (frac_bits > 62) return Status::kPrecisionUnreachable;
+  const uint64_t eight_sum = 8 * (22 * m[0] + 5 * m[1] + 2 * m[2] + m[3]);
+  if (eight_sum >= kLimit >> (3 * level)) return Status::kPrecisionUnreachable;
+  const uint64_t bound = (eight_sum << (3 * level)) + (uint64_t{1} << frac_bits);
+  if (bound >= kLimit) return Status::kPrecisionUnreachable;
+  const uint64_t second = ((6 * m[0] + 2 * m[1]) << level) + 6 * m[0];
+  const int scale = 3 + 3 * level;  // the chord limit is budget16·8·2^(3L)
+  const uint64_t budget = static_cast<uint64_t>(budget16);
+  if (budget < (kLimit >> scale) && second > (budget << scale)) {
+    return Status::kPrecisionUnreachable;
+  }
+  if (step_exact && (uint64_t{1} << (kCoefficientFracBits + level)) < 3 * m[0] + 2 * m[1] + m[2]) {
+    return Status::kPrecisionUnreachable;
+  }
+  return Status::kOk;
+}
+
+// AxisTable in int64_t, for a level AxisFitsLevel64 passed (every term is
+// below B < 2^62).
+FDSURF_OUT_OF_LINE_ON_AVR void AxisTable64(const PowerCurve1& axis, int level, int64_t (&d)[4]) {
+  const int64_t a = axis.c[0];
+  const int64_t six_a = 6 * a;
+  d[0] = internal::ShiftLeft(axis.c[3], 3 * level);
+  d[1] = a + internal::ShiftLeft(axis.c[1], level) + internal::ShiftLeft(axis.c[2], 2 * level);
+  d[2] = six_a + internal::ShiftLeft(axis.c[1], level + 1);
+  d[3] = six_a;
+}
+
 }  // namespace
 
 template <int kDims>
@@ -220,6 +259,36 @@ Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
   const Status status = CurveInputs(curve, settings, &budget16, m);
   if (status != Status::kOk) return status;
   return PrepareAtLevel(curve, m, budget16, level, settings, out);
+}
+
+template <int kDims>
+Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
+                                   const AdaptiveSettings& settings,
+                                   PreparedAdaptiveCurve<kDims, int64_t>* out) {
+  int64_t budget16 = 0;
+  uint64_t m[kDims][4];
+  const Status status = CurveInputs(curve, settings, &budget16, m);
+  if (status != Status::kOk) return status;
+  if (level < 0 || level > kMaxAdaptiveLevel) return Status::kPrecisionUnreachable;
+  const bool step_exact = settings.mode == AdaptiveMode::kStepExact;
+  for (int c = 0; c < kDims; ++c) {
+    const Status fits = AxisFitsLevel64(m[c], level, budget16, step_exact);
+    if (fits != Status::kOk) return fits;
+  }
+  const int frac_bits = kCoefficientFracBits + 3 * level;
+  const int scale = 3 + 3 * level;
+  const uint64_t budget = static_cast<uint64_t>(budget16);
+  out->format.acc_bits = 64;
+  out->format.frac_bits = static_cast<uint8_t>(frac_bits);
+  out->format.word_aligned = 0;  // The cursor halves and doubles its steps.
+  out->finest_level = static_cast<uint8_t>(level);
+  out->mode = settings.mode;
+  for (int c = 0; c < kDims; ++c) AxisTable64(curve[c], level, out->d[c]);
+  // ChordLimit's min(budget16·8·2^(3L), 2^62).
+  out->chord_limit = static_cast<int64_t>(
+      budget < (uint64_t{1} << 62) >> scale ? budget << scale : uint64_t{1} << 62);
+  out->step_limit = int64_t{1} << frac_bits;
+  return Status::kOk;
 }
 
 // The search for the level is the planner's own (FinestLevel, in WideInt);
@@ -350,6 +419,15 @@ template Status PrepareAdaptiveCurveAtLevel<2>(const PowerCurve1 (&)[2], int,
                                                const AdaptiveSettings&, PreparedAdaptiveCurve<2>*);
 template Status PrepareAdaptiveCurveAtLevel<3>(const PowerCurve1 (&)[3], int,
                                                const AdaptiveSettings&, PreparedAdaptiveCurve<3>*);
+template Status PrepareAdaptiveCurveAtLevel<1>(const PowerCurve1 (&)[1], int,
+                                               const AdaptiveSettings&,
+                                               PreparedAdaptiveCurve<1, int64_t>*);
+template Status PrepareAdaptiveCurveAtLevel<2>(const PowerCurve1 (&)[2], int,
+                                               const AdaptiveSettings&,
+                                               PreparedAdaptiveCurve<2, int64_t>*);
+template Status PrepareAdaptiveCurveAtLevel<3>(const PowerCurve1 (&)[3], int,
+                                               const AdaptiveSettings&,
+                                               PreparedAdaptiveCurve<3, int64_t>*);
 template Status CurvePowerCoefficients<1>(const CurveGeometry1 (&)[1], Basis, PowerCurve1 (&)[1]);
 template Status CurvePowerCoefficients<2>(const CurveGeometry1 (&)[2], Basis, PowerCurve1 (&)[2]);
 template Status CurvePowerCoefficients<3>(const CurveGeometry1 (&)[3], Basis, PowerCurve1 (&)[3]);

@@ -383,6 +383,89 @@ TEST(AdaptiveCurve, ALevelChosenElsewhereIsCheckedAsThePlannerChecksIt) {
   EXPECT_GT(accepted_above, 1000);
 }
 
+// A device without Int128 code sets a host's level up in 64-bit arithmetic
+// (the Arduino Uno, issue 17). At every level it must accept exactly what the
+// Int128 form accepts for the 64-bit accumulator, with the same table, and
+// each table it accepts must have B = 8·(22|a| + 5|b| + 2|c| + |d|)·2^(3L) +
+// 2^F below 2^62, computed here exactly.
+TEST(AdaptiveCurve, TheSixtyFourBitSetUpAcceptsWhatTheWideOneAcceptsForThatAccumulator) {
+  std::mt19937_64 rng(20261207);
+  const double tolerances[] = {0.875, 1.0, 4.0, 200.0};
+  int accepted = 0;
+  int needs_wide = 0;  // refused here, taken by the Int128 accumulator
+  for (int trial = 0; trial < 1500; ++trial) {
+    const DoubleCubic cubic = RandomCubic(rng, std::ldexp(1.0, 2 + trial % 26));
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    AdaptiveSettings settings;
+    settings.tolerance_q8 = static_cast<std::uint32_t>(tolerances[trial % 4] * 256);
+    settings.mode = (trial / 4) % 2 == 0 ? AdaptiveMode::kStepExact : AdaptiveMode::kTolerance;
+    for (int level = -1; level <= kMaxAdaptiveLevel + 1; ++level) {
+      settings.max_acc_bits = 64;
+      PreparedAdaptiveCurve<3> wide;
+      const Status wide_status = PrepareAdaptiveCurveAtLevel(raw, level, settings, &wide);
+      PreparedAdaptiveCurve<3, std::int64_t> narrow;
+      const Status narrow_status = PrepareAdaptiveCurveAtLevel(raw, level, settings, &narrow);
+      ASSERT_EQ(narrow_status, wide_status) << trial << " level " << level;
+      if (narrow_status != Status::kOk) {
+        settings.max_acc_bits = 128;
+        needs_wide += PrepareAdaptiveCurveAtLevel(raw, level, settings, &wide) == Status::kOk;
+        continue;
+      }
+      ++accepted;
+      ASSERT_EQ(narrow.format.acc_bits, 64);
+      ASSERT_EQ(narrow.format.frac_bits, wide.format.frac_bits);
+      ASSERT_EQ(narrow.finest_level, level);
+      ASSERT_EQ(narrow.mode, settings.mode);
+      I128 bound = 0;
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 4; ++k) {
+          ASSERT_TRUE(I128(narrow.d[c][k]) == FromInt128(wide.d[c][k])) << trial << " " << c;
+        }
+        I128 sum = 0;
+        for (int k = 0; k < 4; ++k) {
+          const I128 value = raw[c].c[k];
+          sum += (k == 0 ? 22 : k == 1 ? 5 : k == 2 ? 2 : 1) * (value < 0 ? -value : value);
+        }
+        bound = std::max(bound, ((8 * sum) << (3 * level)) + (I128(1) << (16 + 3 * level)));
+      }
+      ASSERT_TRUE(bound < I128(1) << 62) << trial << " level " << level;
+      ASSERT_TRUE(I128(narrow.chord_limit) == FromInt128(wide.chord_limit)) << trial;
+      ASSERT_TRUE(I128(narrow.step_limit) == FromInt128(wide.step_limit)) << trial;
+    }
+  }
+  EXPECT_GT(accepted, 1000);
+  EXPECT_GT(needs_wide, 10000);
+}
+
+// The same agreement exactly at the edges of the 64-bit tests, where random
+// curves seldom fall: the range (the largest |d| with B < 2^62, and one more)
+// and the chord limit (|b| with (2|b|)·2^L equal to it, and one more).
+TEST(AdaptiveCurve, TheSixtyFourBitSetUpDrawsItsEdgesWhereTheWideOneDoes) {
+  AdaptiveSettings settings;
+  settings.tolerance_q8 = 256;
+  settings.max_acc_bits = 64;
+  const std::int64_t budget16 = 256 * 147 - (1 << 15) - 64;
+  for (int level = 5; level <= 15; ++level) {
+    const I128 room = (I128(1) << 62) - (I128(1) << (16 + 3 * level)) - 1;
+    const auto largest_d = static_cast<std::int64_t>(room >> (3 * level + 3));
+    const std::int64_t largest_b = budget16 << (2 + 2 * level);
+    const std::int64_t cases[4][2] = {
+        {0, largest_d}, {0, largest_d + 1}, {largest_b, 0}, {largest_b + 1, 0}};
+    for (int k = 0; k < 4; ++k) {
+      const PowerCurve1 raw[3] = {{{0, cases[k][0], 0, cases[k][1]}}, {}, {}};
+      PreparedAdaptiveCurve<3> wide;
+      PreparedAdaptiveCurve<3, std::int64_t> narrow;
+      const Status expected = k % 2 == 0 ? Status::kOk : Status::kPrecisionUnreachable;
+      if (cases[k][0] != 0 && (cases[k][0] * 5 * 8) >> (62 - 3 * level) != 0) continue;
+      EXPECT_EQ(PrepareAdaptiveCurveAtLevel(raw, level, settings, &wide), expected)
+          << "level " << level << " case " << k;
+      EXPECT_EQ(PrepareAdaptiveCurveAtLevel(raw, level, settings, &narrow), expected)
+          << "level " << level << " case " << k;
+    }
+  }
+}
+
 TEST(AdaptiveCurve, ALevelChosenElsewhereIsRefusedOutsideItsRange) {
   PowerCurve1 raw[3] = {{{1 << 20, 5, 6, 7}}, {{0, 0, 0, 0}}, {{0, 0, 0, 0}}};
   AdaptiveSettings settings;

@@ -65,8 +65,11 @@ struct PowerCurve1 {
   int64_t c[4];
 };
 
-/// A curve ready for adaptive stepping.
-template <int kDims>
+/// A curve ready for adaptive stepping. Its entries are Int128 (either
+/// accumulator: format.acc_bits says which), or int64_t for a table set up for
+/// the 64-bit accumulator only (PrepareAdaptiveCurveAtLevel's second form,
+/// for a device without Int128 code).
+template <int kDims, typename Entry = Int128>
 struct PreparedAdaptiveCurve {
   /// frac_bits = kCoefficientFracBits + 3·finest_level.
   DiffFormat format;
@@ -74,11 +77,11 @@ struct PreparedAdaptiveCurve {
   uint8_t finest_level;
   AdaptiveMode mode;
   /// Δ⁰..Δ³ per axis at t = 0 for the step 2^-L.
-  Int128 d[kDims][4];
+  Entry d[kDims][4];
   /// A step is taken only when max(|Δ²|, |Δ² − Δ³|) ≤ chord_limit on every axis.
-  Int128 chord_limit;
+  Entry chord_limit;
   /// In kStepExact, a step is taken only when |Δ¹| ≤ step_limit (one quantum).
-  Int128 step_limit;
+  Entry step_limit;
 };
 
 /// Plans and sets up one curve from its power coefficients. Errors:
@@ -110,6 +113,15 @@ template <int kDims>
 Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
                                    const AdaptiveSettings& settings,
                                    PreparedAdaptiveCurve<kDims>* out);
+/// The same check and table for the 64-bit accumulator only, in 64-bit
+/// arithmetic: a device built without Int128 code (the Arduino Uno, issue 17)
+/// links this one. It accepts exactly the curves and levels that the form
+/// above accepts with settings.max_acc_bits = 64, and forms the same table
+/// (docs/toolpaths.md, "A level chosen by the host"). Errors as above.
+template <int kDims>
+Status PrepareAdaptiveCurveAtLevel(const PowerCurve1 (&curve)[kDims], int level,
+                                   const AdaptiveSettings& settings,
+                                   PreparedAdaptiveCurve<kDims, int64_t>* out);
 
 /// Converts a curve's basis geometry (fdsurf/forward_difference.h) to power
 /// coefficients, rounding each once to 2^-kCoefficientFracBits quanta.
@@ -215,8 +227,9 @@ class AdaptiveCurveCursor {
   AdaptiveCurveCursor() = default;
   explicit AdaptiveCurveCursor(const PreparedAdaptiveCurve<kDims>& curve) { Reset(curve); }
 
-  /// Starts over on `curve`.
-  void Reset(const PreparedAdaptiveCurve<kDims>& curve) {
+  /// Starts over on `curve` (Int128 entries, or int64_t ones for Acc = int64_t).
+  template <typename Entry>
+  void Reset(const PreparedAdaptiveCurve<kDims, Entry>& curve) {
     // The rounding half rides in the position, which only ever has steps
     // added to it (halving and doubling change d[1..3]), so a point is
     // floor(d[0]·2^-F): no add per point. The planner's bound covers it

@@ -149,6 +149,7 @@ inline void Load(const Int128& from, int64_t* to) {
   *to = static_cast<int64_t>(from.lo);
 }
 inline void Load(const Int128& from, Int128* to) { *to = from; }
+inline void Load(int64_t from, int64_t* to) { *to = from; }
 
 /// Loads a table entry into a stepper's accumulator in the stepping format:
 /// for a word-aligned 64-bit table (DiffFormat::word_aligned) moved to 32
