@@ -467,6 +467,57 @@ TEST(PathGenerator, MoveStepsThroughRoundedPointsOfTheStraightLine) {
   EXPECT_EQ(p[1], 382);
 }
 
+// A straight move is stepped by a 64-bit counter, not the adaptive cursor:
+// it must emit the points the adaptive cursor emits for the move's line at
+// StraightMoveLevel (with Int128, which takes every length), at lengths from
+// 0 to 2^20 steps on the longest axis, negative and positive, and every
+// point must be the rounded point of the line at j/2^L (halves up, computed
+// here in __int128).
+TEST(StraightMoveCursor, EmitsTheAdaptiveCursorsPointsOfTheMove) {
+  std::mt19937_64 rng(20261206);
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = motion::kLineToleranceQ8;
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int bits = trial % 21;
+    const std::int32_t longest = static_cast<std::int32_t>(rng() % ((1u << bits) + 1));
+    std::int32_t from[3];
+    std::int32_t to[3];
+    PowerCurve1 line[3];
+    for (int c = 0; c < 3; ++c) {
+      from[c] = static_cast<std::int32_t>(rng() % (1u << 26));
+      const std::int32_t length =
+          c == 0 ? longest : static_cast<std::int32_t>(rng() % (std::uint64_t(longest) + 1));
+      to[c] = rng() % 2 == 0 && from[c] >= length ? from[c] - length : from[c] + length;
+      line[c] =
+          PowerCurve1{{0, 0, std::int64_t{to[c] - from[c]} << 16, std::int64_t{from[c]} << 16}};
+    }
+    const int level = motion::StraightMoveLevel(line);
+    PreparedAdaptiveCurve<3> prepared;
+    ASSERT_EQ(PrepareAdaptiveCurveAtLevel(line, level, settings, &prepared), Status::kOk);
+    AdaptiveCurveCursor<Int128, 3> adaptive(prepared);
+    motion::StraightMoveCursor<3> straight;
+    straight.Reset(from, to, level);
+    std::int32_t expected[3];
+    std::int32_t point[3];
+    std::uint32_t position = 0;
+    while (adaptive.Next(expected, &position)) {
+      ASSERT_TRUE(straight.Next(point)) << trial;
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(point[c], expected[c]) << trial << " at " << position;
+        const __int128 twice = (__int128{2} * from[c] + 1) * (__int128{1} << level) +
+                               __int128{2} * (to[c] - from[c]) * position;
+        ASSERT_EQ(point[c], static_cast<std::int32_t>(twice >> (level + 1))) << trial;
+      }
+      ++checked;
+    }
+    EXPECT_FALSE(straight.Next(point)) << trial;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(point[c], to[c]) << trial;
+  }
+  EXPECT_GT(checked, 1000000);
+}
+
 TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {
   std::uint8_t detail = 0;
   // Inside.

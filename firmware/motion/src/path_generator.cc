@@ -194,26 +194,38 @@ AdaptiveSettings StepExactSettings(uint32_t tolerance_q8) {
   return settings;
 }
 
-// Sets up a line the way execution will: by the planner, or, for a
-// PREPARED_CURVE (level ≥ 0), by checking the host's level.
+// The table entries of the lines this device steps (FDSURF_DEVICE_WIDE_TABLES).
+#if FDSURF_DEVICE_WIDE_TABLES
+using TableEntry = Int128;
+#else
+using TableEntry = int64_t;
+#endif
+
+// Sets up a line (relative to its first point) the way execution will: by
+// the planner, or, for a PREPARED_CURVE (level ≥ 0), by checking the host's
+// level.
 template <int kDims>
-Status PrepareLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
-                   PreparedAdaptiveCurve<kDims>* prepared) {
+Status PrepareLine(const PowerCurve1 (&relative)[kDims], uint32_t tolerance_q8, int host_level,
+                   PreparedAdaptiveCurve<kDims, TableEntry>* prepared) {
   const AdaptiveSettings settings = StepExactSettings(tolerance_q8);
 #if FDSURF_DEVICE_PLANNER
-  if (host_level < 0) return PrepareAdaptiveCurve(curve, settings, prepared);
+  if (host_level < 0) return PrepareAdaptiveCurve(relative, settings, prepared);
 #endif
-  return PrepareAdaptiveCurveAtLevel(curve, host_level, settings, prepared);
+  return PrepareAdaptiveCurveAtLevel(relative, host_level, settings, prepared);
 }
 
 // The planner (or, for a prepared curve, the check of the host's level) must
-// accept the line, and every point it will emit must lie within the travel.
+// accept the line as execution steps it (relative to its first point), and
+// every point it will emit must lie within the travel.
 template <int kDims>
 ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
                     const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
-  PreparedAdaptiveCurve<kDims> prepared;
+  PreparedAdaptiveCurve<kDims, TableEntry> prepared;
+  PowerCurve1 relative[kDims];
+  int32_t first[kDims];
+  RelativeToFirstPoint(curve, relative, first);
   if (work != nullptr) ++(host_level < 0 ? work->lines : work->prepared_lines);
-  const Status status = PrepareLine(curve, tolerance_q8, host_level, &prepared);
+  const Status status = PrepareLine(relative, tolerance_q8, host_level, &prepared);
   if (status != Status::kOk) {
     *detail = static_cast<uint8_t>(status);
     return ErrorCode::kPlannerRefused;
@@ -288,6 +300,53 @@ void ReverseCurve(PowerCurve1 (&curve)[kDims]) {
     curve[c].c[2] = -(3 * a + 2 * b + cc);
     curve[c].c[3] = a + b + cc + d;
   }
+}
+
+template <int kDims>
+void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relative)[kDims],
+                          int32_t (&first)[kDims]) {
+  for (int c = 0; c < kDims; ++c) {
+    first[c] = RoundToQuanta(curve[c].c[3], kCoefficientFracBits);
+    relative[c] = curve[c];
+    relative[c].c[3] -= static_cast<int64_t>(first[c]) * kOneStep;
+  }
+}
+
+template <int kDims>
+void StraightMoveCursor<kDims>::Reset(const int32_t (&from)[kDims], const int32_t (&to)[kDims],
+                                      int level) {
+  for (int c = 0; c < kDims; ++c) {
+    numerator_[c] = fdsurf::internal::ShiftLeft(2 * static_cast<int64_t>(from[c]) + 1, level);
+    increment_[c] = 2 * (static_cast<int64_t>(to[c]) - from[c]);
+    last_[c] = from[c];
+  }
+  remaining_ = uint32_t{1} << level;
+  shift_ = static_cast<uint8_t>(level + 1);
+  started_ = false;
+}
+
+template <int kDims>
+bool StraightMoveCursor<kDims>::Next(int32_t (&point)[kDims]) {
+  if (!started_) {
+    started_ = true;
+    for (int c = 0; c < kDims; ++c) point[c] = last_[c];
+    return true;
+  }
+  while (remaining_ > 0) {
+    --remaining_;
+    bool moved = false;
+    for (int c = 0; c < kDims; ++c) {
+      numerator_[c] += increment_[c];
+      point[c] =
+          static_cast<int32_t>(fdsurf::internal::ShiftRightArithmetic(numerator_[c], shift_));
+      moved = moved || point[c] != last_[c];
+    }
+    if (moved) {
+      for (int c = 0; c < kDims; ++c) last_[c] = point[c];
+      return true;
+    }
+  }
+  return false;
 }
 
 template <int kDims>
@@ -396,22 +455,27 @@ void PathGenerator<kDims>::Fail(Status status) {
 template <int kDims>
 bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8,
                                        int host_level) {
-  const Status status = PrepareLine(curve, tolerance_q8, host_level, &prepared_);
+  PowerCurve1 relative[kDims];
+  RelativeToFirstPoint(curve, relative, line_start_);
+  const Status status = PrepareLine(relative, tolerance_q8, host_level, &prepared_);
   if (status != Status::kOk) {
     Fail(status);
     return false;
   }
-  cursor_wide_ = prepared_.format.acc_bits != 64;
-  if (cursor_wide_) {
+#if FDSURF_DEVICE_WIDE_TABLES
+  if (prepared_.format.acc_bits != 64) {
+    path_ = Path::kLine128;
     cursor128_.Reset(prepared_);
-  } else {
-    cursor64_.Reset(prepared_);
+    return true;
   }
+#endif
+  path_ = Path::kLine64;
+  cursor64_.Reset(prepared_);
   return true;
 }
 
 template <int kDims>
-bool PathGenerator<kDims>::StartTravel(const int32_t (&target)[kDims]) {
+void PathGenerator<kDims>::StartTravel(const int32_t (&target)[kDims]) {
   PowerCurve1 line[kDims];
   for (int c = 0; c < kDims; ++c) {
     line[c].c[0] = 0;
@@ -419,7 +483,8 @@ bool PathGenerator<kDims>::StartTravel(const int32_t (&target)[kDims]) {
     line[c].c[2] = (static_cast<int64_t>(target[c]) - position_[c]) * kOneStep;
     line[c].c[3] = static_cast<int64_t>(position_[c]) * kOneStep;
   }
-  return PrepareInto(line, kLineToleranceQ8, StraightMoveLevel(line));
+  path_ = Path::kStraight;
+  straight_.Reset(position_, target, StraightMoveLevel(line));
 }
 
 template <int kDims>
@@ -479,7 +544,8 @@ void PathGenerator<kDims>::Start(const protocol::Command& command) {
       for (int c = 0; c < kDims; ++c) target[c] = command.body.move.target[c];
       lift_for_travel_ = false;
       after_stepping_ = Stage::kFinish;
-      stage_ = StartTravel(target) ? Stage::kStepping : Stage::kIdle;
+      StartTravel(target);
+      stage_ = Stage::kStepping;
       return;
     }
     case MessageType::kPen:
@@ -499,8 +565,17 @@ void PathGenerator<kDims>::Start(const protocol::Command& command) {
 
 template <int kDims>
 bool PathGenerator<kDims>::NextPoint(int32_t (&point)[kDims]) {
+  if (path_ == Path::kStraight) return straight_.Next(point);
   uint32_t position = 0;
-  return cursor_wide_ ? cursor128_.Next(point, &position) : cursor64_.Next(point, &position);
+#if FDSURF_DEVICE_WIDE_TABLES
+  const bool more = path_ == Path::kLine128 ? cursor128_.Next(point, &position)
+                                            : cursor64_.Next(point, &position);
+#else
+  const bool more = cursor64_.Next(point, &position);
+#endif
+  if (!more) return false;
+  for (int c = 0; c < kDims; ++c) point[c] += line_start_[c];
+  return true;
 }
 
 // One state machine over the stages of a command (stepping, next line,
@@ -591,7 +666,7 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
           pen_down_ = false;
           Emit(MakeEntry(EntryKind::kPenUp));
         }
-        if (!StartTravel(line_start_)) return false;
+        StartTravel(line_start_);
         after_stepping_ = Stage::kAfterTravel;
         stage_ = Stage::kStepping;
         continue;
@@ -620,6 +695,10 @@ bool PathGenerator<kDims>::Next(uint8_t* entry) {  // NOLINT(readability-functio
 
 template void ReverseCurve<2>(PowerCurve1 (&)[2]);
 template void ReverseCurve<3>(PowerCurve1 (&)[3]);
+template void RelativeToFirstPoint<2>(const PowerCurve1 (&)[2], PowerCurve1 (&)[2], int32_t (&)[2]);
+template void RelativeToFirstPoint<3>(const PowerCurve1 (&)[3], PowerCurve1 (&)[3], int32_t (&)[3]);
+template class StraightMoveCursor<2>;
+template class StraightMoveCursor<3>;
 template int StraightMoveLevel<2>(const PowerCurve1 (&)[2]);
 template int StraightMoveLevel<3>(const PowerCurve1 (&)[3]);
 template bool TravelPlannable<2>(const protocol::MachineConfig&, uint8_t*);

@@ -312,7 +312,8 @@ class Device {
   FDSURF_NODISCARD uint8_t Features() const {
     const uint8_t endstops = endstops_ != nullptr ? protocol::kFeatureEndstops : 0;
     const uint8_t planner = FDSURF_DEVICE_PLANNER ? protocol::kFeaturePlanner : 0;
-    return static_cast<uint8_t>(endstops | planner | protocol::kFeaturePreparedCurves);
+    const uint8_t narrow = FDSURF_DEVICE_WIDE_TABLES ? 0 : protocol::kFeature64BitTables;
+    return static_cast<uint8_t>(endstops | planner | narrow | protocol::kFeaturePreparedCurves);
   }
 
   void FillStatus(protocol::StatusReport* report) const {

@@ -20,6 +20,20 @@
 #include "fdsurf/motion/entry.h"
 #include "fdsurf/protocol/messages.h"
 
+/// 1 (the default): the device steps a line with the 64-bit accumulator when
+/// its table fits, else with Int128 (the planner's lines need it at page
+/// scale). 0: 64-bit tables only, and no Int128 code, for small chips (the
+/// Arduino Uno, issue 17); a PREPARED_CURVE whose table does not fit is
+/// refused (kPlannerRefused, detail kPrecisionUnreachable), so its host
+/// splits lines first (HELLO_REPLY's kFeature64BitTables says so). Needs
+/// FDSURF_DEVICE_PLANNER=0: a device's planner cannot split a PATCH's lines.
+#ifndef FDSURF_DEVICE_WIDE_TABLES
+#define FDSURF_DEVICE_WIDE_TABLES 1
+#endif
+#if !FDSURF_DEVICE_WIDE_TABLES && FDSURF_DEVICE_PLANNER
+#error "FDSURF_DEVICE_WIDE_TABLES=0 needs FDSURF_DEVICE_PLANNER=0"
+#endif
+
 namespace fdsurf {
 namespace motion {
 
@@ -81,6 +95,43 @@ struct ValidationWork {
 /// and without the planner's search and wide integers.
 template <int kDims>
 int StraightMoveLevel(const PowerCurve1 (&line)[kDims]);
+
+/// A line as the device steps it: relative to its first point, so that the
+/// table's Δ⁰ holds the rounding of the start and not the machine's
+/// position (a smaller table: the 64-bit accumulator takes more lines).
+/// `first` = the first point rounded to steps, `relative` = the curve with
+/// first·2^16 taken from its constant term. Each point of the relative line
+/// plus `first` is the point of the line, bit for bit (round(x − k) =
+/// round(x) − k for a whole k).
+template <int kDims>
+void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relative)[kDims],
+                          int32_t (&first)[kDims]);
+
+/// The points of a straight move from `from` to `to` (steps), exactly as
+/// the adaptive cursor emits them for the move's line at its
+/// StraightMoveLevel L: the distinct points round(from + (to − from)·j/2^L),
+/// halves up, j = 0 .. 2^L (at that level no step can double, so the cursor
+/// takes every j). One 64-bit addition per axis and j, at any length in the
+/// travel (|to − from| ≤ 2^26 makes every value below 2^55), so no move
+/// needs Int128.
+template <int kDims>
+class StraightMoveCursor {
+ public:
+  /// Starts the move; `level` is StraightMoveLevel of its line.
+  void Reset(const int32_t (&from)[kDims], const int32_t (&to)[kDims], int level);
+  /// The next point, the first one first; false after the last.
+  bool Next(int32_t (&point)[kDims]);
+
+ private:
+  // (2·from + 1)·2^L + 2·(to − from)·j: the point is this over 2^(L+1),
+  // rounded down.
+  int64_t numerator_[kDims] = {};
+  int64_t increment_[kDims] = {};
+  int32_t last_[kDims] = {};
+  uint32_t remaining_ = 0;  // values of j still to take
+  uint8_t shift_ = 1;       // L + 1
+  bool started_ = false;
+};
 
 /// Whether every axis's travel is at most kMaxPlannableTravelSteps; *axis =
 /// the first that is not.
@@ -145,14 +196,15 @@ class PathGenerator {
     kFinish,         // pen up (patch), then the command-done entry
   };
 
-  /// Prepares `curve` into prepared_ (by the planner for kPlannerLevel,
-  /// else at the host's level) and points the cursor at it.
+  /// Prepares `curve` relative to its first point into prepared_ (by the
+  /// planner for kPlannerLevel, else at the host's level) and points the
+  /// cursor at it.
   bool PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level);
   bool NextPoint(int32_t (&point)[kDims]);
   /// Queues an entry to hand out before anything else.
   void Emit(uint8_t entry);
-  /// Prepares a straight pen-at-current-state move to `target` into travel_.
-  bool StartTravel(const int32_t (&target)[kDims]);
+  /// Starts a straight pen-at-current-state move to `target`.
+  void StartTravel(const int32_t (&target)[kDims]);
   void Fail(Status status);
 
   Stage stage_ = Stage::kIdle;
@@ -181,10 +233,18 @@ class PathGenerator {
   // the path being stepped now (the line, or a straight travel move to it).
   PowerCurve1 line_[kDims];
   int32_t line_start_[kDims] = {};
+  /// What is being stepped: a straight move, or the line (relative to
+  /// line_start_) with the 64-bit or the Int128 accumulator.
+  enum class Path : uint8_t { kStraight, kLine64, kLine128 };
+  Path path_ = Path::kStraight;
+  StraightMoveCursor<kDims> straight_;
+#if FDSURF_DEVICE_WIDE_TABLES
   PreparedAdaptiveCurve<kDims> prepared_;
-  bool cursor_wide_ = false;
-  AdaptiveCurveCursor<int64_t, kDims> cursor64_;
   AdaptiveCurveCursor<Int128, kDims> cursor128_;
+#else
+  PreparedAdaptiveCurve<kDims, int64_t> prepared_;
+#endif
+  AdaptiveCurveCursor<int64_t, kDims> cursor64_;
 
   // Entries to hand out before stepping on (at most a pen event and a
   // command-done marker at a time).

@@ -323,8 +323,15 @@ constexpr uint8_t kFeaturePreparedCurves = 0x02;
 /// HelloReply::features: the device has the planner (FDSURF_DEVICE_PLANNER)
 /// and takes PATCH and CURVE; without it, the host sends PREPARED_CURVEs.
 constexpr uint8_t kFeaturePlanner = 0x04;
+/// HelloReply::features: the device steps 64-bit tables only
+/// (FDSURF_DEVICE_WIDE_TABLES=0, motion/path_generator.h): it refuses a
+/// PREPARED_CURVE whose table, relative to its first point, needs the
+/// 128-bit accumulator, so the host sends such a line in pieces
+/// (host::SplitForSixtyFourBitTables).
+constexpr uint8_t kFeature64BitTables = 0x08;
 /// Every feature bit this version knows; a HELLO_REPLY with another is refused.
-constexpr uint8_t kKnownFeatures = kFeatureEndstops | kFeaturePreparedCurves | kFeaturePlanner;
+constexpr uint8_t kKnownFeatures =
+    kFeatureEndstops | kFeaturePreparedCurves | kFeaturePlanner | kFeature64BitTables;
 
 struct StatusReport {
   DeviceState state;
