@@ -407,6 +407,60 @@ TEST(SimulatedPlotter, DrawsTheSameWhenTheHostPlansTheLines) {
   EXPECT_EQ(run.pens.size(), Baseline().pens.size());
 }
 
+// Whether a device of 64-bit tables (FDSURF_DEVICE_WIDE_TABLES=0) takes a
+// PREPARED_CURVE: its own check, relative to the first point, at its level.
+bool FitsSixtyFourBits(const protocol::PreparedCurveCommand& curve) {
+  PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
+  PowerCurve1 relative[2];
+  std::int32_t first[2];
+  motion::RelativeToFirstPoint(line, relative, first);
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = curve.tolerance_q8;
+  PreparedAdaptiveCurve<2, std::int64_t> table;
+  return PrepareAdaptiveCurveAtLevel(relative, curve.level, settings, &table) == Status::kOk;
+}
+
+// A device of 64-bit tables (the Arduino Uno) is sent the lines it cannot
+// take in pieces. Every piece fits its check, and the pieces still draw the
+// teapot within the tolerance of the exact curves (an independent dense
+// evaluation), with no curve left out and within the motion limits.
+TEST(SimulatedPlotter, ASixtyFourBitDeviceGetsLongLinesInPiecesThatKeepTheTolerance) {
+  host::StreamJob job = SmallTeapotJob();
+  host::PrepareOnHost(&job);
+  std::size_t lines = 0;
+  std::size_t too_wide = 0;
+  for (const protocol::Command& command : job.commands) {
+    if (command.type != protocol::MessageType::kPreparedCurve) continue;
+    ++lines;
+    too_wide += FitsSixtyFourBits(command.body.prepared_curve) ? 0 : 1;
+  }
+  host::StreamJob split = job;
+  host::SplitForSixtyFourBitTables(&split);
+  ASSERT_EQ(split.labels.size(), split.commands.size());
+  std::size_t pieces = 0;
+  for (std::size_t k = 0; k < split.commands.size(); ++k) {
+    const protocol::Command& command = split.commands[k];
+    if (command.type != protocol::MessageType::kPreparedCurve) continue;
+    ++pieces;
+    EXPECT_TRUE(FitsSixtyFourBits(command.body.prepared_curve)) << split.labels[k];
+  }
+  std::printf("%zu of %zu lines split, into %zu pieces in all\n", too_wide, lines,
+              pieces - (lines - too_wide));
+  EXPECT_GT(too_wide, 0u);
+  EXPECT_GT(pieces, lines);
+  EXPECT_EQ(split.commands.size() - job.commands.size(), pieces - lines);
+  const Streamed run = Stream(split, PlotterOptions{});
+  ASSERT_TRUE(run.result.finished) << run.result.error;
+  EXPECT_EQ(run.result.executed, split.commands.size());
+  const DrawingComparison comparison = CompareDrawing(run.drawn, Reference(job), 2);
+  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
+  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
+  EXPECT_GT(comparison.drawn_points, 10000u);
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+}
+
 // The cost model charges a prepared line the check at its level (43,014
 // cycles on the ATmega2560), not the planner's search (425,039): the small
 // teapot as PREPARED_CURVEs keeps the Mega's main loop validating for a

@@ -10,6 +10,7 @@
 #include "../fdsurf/runners/runner.h"
 #include "../fdsurf/runners/transport_loop.h"
 #include "../fdsurf/stream_command.h"
+#include "fdsurf/adaptive.h"
 #include "fdsurf/host/stream.h"
 #include "fdsurf/protocol/messages.h"
 
@@ -68,6 +69,43 @@ TEST(FitJobToDevice, ADeviceWithoutAPlannerIsGivenPreparedCurvesOnly) {
       Hello(protocol::kFeaturePlanner | protocol::kFeaturePreparedCurves);
   EXPECT_EQ(
       FitJobToDevice(JobOf(protocol::MessageType::kPatch), full, "d", options).commands.size(), 2u);
+}
+
+// A device of 64-bit tables (the Arduino Uno) is sent a line whose table
+// needs Int128 in pieces; another device gets the line whole.
+TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
+  StreamOptions options;
+  options.quiet = true;
+  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
+  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
+  curve.dims = 2;
+  curve.tolerance_q8 = 256;
+  curve.power[0] = PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}};
+  curve.power[1] = PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}};
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = curve.tolerance_q8;
+  const PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
+  PreparedAdaptiveCurve<2> planned;
+  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
+  ASSERT_EQ(planned.format.acc_bits, 128);
+  curve.level = planned.finest_level;
+
+  const StreamJob whole =
+      FitJobToDevice(job, Hello(protocol::kFeaturePreparedCurves), "d", options);
+  EXPECT_EQ(whole.commands.size(), 2u);
+  const StreamJob pieces = FitJobToDevice(
+      job, Hello(protocol::kFeaturePreparedCurves | protocol::kFeature64BitTables), "d", options);
+  ASSERT_GT(pieces.commands.size(), 3u);
+  ASSERT_EQ(pieces.labels.size(), pieces.commands.size());
+  const std::string of = " of " + std::to_string(pieces.commands.size() - 1);
+  EXPECT_EQ(pieces.labels[1], "the drawing, piece 1" + of);
+  EXPECT_EQ(pieces.labels.back(),
+            "the drawing, piece " + std::to_string(pieces.commands.size() - 1) + of);
+  // The pieces run from the line's start to its end.
+  EXPECT_EQ(pieces.commands[1].body.prepared_curve.power[0].c[3], curve.power[0].c[3]);
+  const PowerCurve1& last = pieces.commands.back().body.prepared_curve.power[1];
+  EXPECT_EQ(last.c[0] + last.c[1] + last.c[2] + last.c[3], (2000 - 700 + 50) << 16);
 }
 
 }  // namespace

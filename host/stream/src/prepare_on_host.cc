@@ -175,7 +175,153 @@ void Prepare(StreamJob* job) {
   preparer.Finish(job);
 }
 
+// How often a line is halved at most for a device of 64-bit tables; each
+// halving makes a piece's table about 16 times smaller, so the teapot's
+// lines need at most a few.
+constexpr int kMaxSplitDepth = 16;
+
+// round(numerator / 2^bits), halves up (C++20's >> of a negative value is
+// the floor).
+std::int64_t RoundShifted(__int128 numerator, int bits) {
+  if (bits == 0) return static_cast<std::int64_t>(numerator);
+  return static_cast<std::int64_t>((numerator + (__int128{1} << (bits - 1))) >> bits);
+}
+
+// The piece of `line` over [i/2^k, (i+1)/2^k] as power coefficients in v
+// from 0 to 1: x(u0 + v/2^k) with u0 = i/2^k, each coefficient times 2^(3k)
+// exact in __int128 (below 2^96 for |coefficients| < 2^47 and k ≤ 16), then
+// rounded once.
+template <int kDims>
+void PieceOf(const PowerCurve1 (&line)[kDims], int k, std::uint64_t i,
+             PowerCurve1 (&piece)[kDims]) {
+  const __int128 u = i;
+  const __int128 w = __int128{1} << k;
+  for (int c = 0; c < kDims; ++c) {
+    const __int128 a = line[c].c[0];
+    const __int128 b = line[c].c[1];
+    const __int128 cc = line[c].c[2];
+    const __int128 d = line[c].c[3];
+    const __int128 scaled[4] = {
+        a,
+        3 * a * u + b * w,
+        3 * a * u * u + 2 * b * u * w + cc * w * w,
+        a * u * u * u + b * u * u * w + cc * u * w * w + d * w * w * w,
+    };
+    for (int j = 0; j < 4; ++j) piece[c].c[j] = RoundShifted(scaled[j], 3 * k);
+  }
+}
+
+// The level this host's planner chooses for `piece`, and whether a device of
+// 64-bit tables takes the piece at it (relative to its first point, as the
+// device steps it: motion::RelativeToFirstPoint).
+template <int kDims>
+Status NarrowLevelOf(const PowerCurve1 (&piece)[kDims], std::uint32_t tolerance_q8, int* level) {
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = tolerance_q8;
+  PreparedAdaptiveCurve<kDims> planned;
+  const Status planned_status = PrepareAdaptiveCurve(piece, settings, &planned);
+  if (planned_status != Status::kOk) return planned_status;
+  *level = planned.finest_level;
+  PowerCurve1 relative[kDims];
+  std::int32_t first[kDims];
+  motion::RelativeToFirstPoint(piece, relative, first);
+  PreparedAdaptiveCurve<kDims, std::int64_t> narrow;
+  return PrepareAdaptiveCurveAtLevel(relative, *level, settings, &narrow);
+}
+
+// The pieces of one PREPARED_CURVE for a device of 64-bit tables, in order.
+template <int kDims>
+class Splitter {
+ public:
+  Splitter(const protocol::PreparedCurveCommand& line, const std::string& label)
+      : line_(line), label_(label) {
+    for (int c = 0; c < kDims; ++c) whole_[c] = line.power[c];
+  }
+
+  std::vector<protocol::PreparedCurveCommand> Pieces() {
+    if (Fits(whole_, line_.level)) return {line_};
+    Split(0, 0);
+    return std::move(pieces_);
+  }
+
+ private:
+  bool Fits(const PowerCurve1 (&piece)[kDims], int level) const {
+    PowerCurve1 relative[kDims];
+    std::int32_t first[kDims];
+    motion::RelativeToFirstPoint(piece, relative, first);
+    AdaptiveSettings settings;
+    settings.mode = AdaptiveMode::kStepExact;
+    settings.tolerance_q8 = line_.tolerance_q8;
+    PreparedAdaptiveCurve<kDims, std::int64_t> narrow;
+    return PrepareAdaptiveCurveAtLevel(relative, level, settings, &narrow) == Status::kOk;
+  }
+
+  void Split(int k, std::uint64_t i) {
+    PowerCurve1 piece[kDims];
+    PieceOf(whole_, k, i, piece);
+    int level = 0;
+    const Status status = NarrowLevelOf(piece, line_.tolerance_q8, &level);
+    if (status == Status::kOk) {
+      protocol::PreparedCurveCommand command = line_;
+      command.level = static_cast<std::uint8_t>(level);
+      for (int c = 0; c < kDims; ++c) command.power[c] = piece[c];
+      pieces_.push_back(command);
+      return;
+    }
+    if ((status != Status::kOk && status != Status::kPrecisionUnreachable) || k == kMaxSplitDepth) {
+      throw EngineError(label_ + ": " + StatusMessage(status) + " (a piece of 1/2^" +
+                        std::to_string(k) + " of it, for a device of 64-bit tables)");
+    }
+    Split(k + 1, 2 * i);
+    Split(k + 1, 2 * i + 1);
+  }
+
+  const protocol::PreparedCurveCommand& line_;
+  const std::string& label_;
+  PowerCurve1 whole_[kDims];
+  std::vector<protocol::PreparedCurveCommand> pieces_;
+};
+
+template <int kDims>
+void SplitEach(StreamJob* job) {
+  std::vector<Command> commands;
+  std::vector<std::string> labels;
+  std::vector<std::size_t> first_of;
+  for (std::size_t index = 0; index < job->commands.size(); ++index) {
+    const Command& command = job->commands[index];
+    first_of.push_back(commands.size());
+    if (command.type != MessageType::kPreparedCurve) {
+      commands.push_back(command);
+      labels.push_back(job->labels[index]);
+      continue;
+    }
+    const std::vector<protocol::PreparedCurveCommand> pieces =
+        Splitter<kDims>(command.body.prepared_curve, job->labels[index]).Pieces();
+    for (std::size_t j = 0; j < pieces.size(); ++j) {
+      Command piece = command;
+      piece.body.prepared_curve = pieces[j];
+      commands.push_back(piece);
+      labels.push_back(pieces.size() == 1
+                           ? job->labels[index]
+                           : job->labels[index] + ", piece " + std::to_string(j + 1) + " of " +
+                                 std::to_string(pieces.size()));
+    }
+  }
+  for (LayerStart& layer : job->layers) layer.command = first_of[layer.command];
+  job->commands = std::move(commands);
+  job->labels = std::move(labels);
+}
+
 }  // namespace
+
+void SplitForSixtyFourBitTables(StreamJob* job) {
+  if (job->config.axes == 3) {
+    SplitEach<3>(job);
+  } else {
+    SplitEach<2>(job);
+  }
+}
 
 void PrepareOnHost(StreamJob* job) {
   if (job->config.axes == 3) {

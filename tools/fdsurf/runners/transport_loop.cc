@@ -343,9 +343,10 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
       }
     }
   }
-  const std::uint32_t tick_hz = hello.tick_hz;
-  if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return job;
   StreamJob fitted = job;
+  if ((hello.features & protocol::kFeature64BitTables) != 0) SplitForSixtyFourBitTables(&fitted);
+  const std::uint32_t tick_hz = hello.tick_hz;
+  if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return fitted;
   fitted.config.max_rate = std::min(job.config.max_rate, tick_hz);
   fitted.config.travel_rate = std::min(job.config.travel_rate, tick_hz);
   for (protocol::Command& command : fitted.commands) {

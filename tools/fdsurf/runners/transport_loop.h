@@ -137,8 +137,11 @@ std::uint32_t Milliseconds(double seconds);
 /// The job as the device can run it: a device that ticks slower than the
 /// job's speed needs (max_rate or travel_rate steps/s over HELLO's tick_hz)
 /// gets that speed limit lowered to its tick rate, with a note on stderr
-/// (unless quiet) that names the device and both speeds. DeviceError when the device drives
-/// fewer axes than the job needs.
+/// (unless quiet) that names the device and both speeds; a device of 64-bit
+/// tables (protocol::kFeature64BitTables) gets every PREPARED_CURVE it could
+/// not take in pieces (SplitForSixtyFourBitTables). DeviceError when the
+/// device drives fewer axes than the job needs, or has no planner and the
+/// job has PATCH or CURVE commands.
 StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello,
                          const std::string& device, const StreamOptions& o);
 

@@ -197,6 +197,23 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
 /// jobs it builds).
 void PrepareOnHost(StreamJob* job);
 
+/// The job for a device that steps 64-bit tables only (HELLO_REPLY's
+/// protocol::kFeature64BitTables, the Arduino Uno): every PREPARED_CURVE whose
+/// table, relative to its first point, does not fit the 64-bit accumulator
+/// at its level (the device's own check, PrepareAdaptiveCurveAtLevel's
+/// 64-bit form) is replaced by its pieces over [i/2^k, (i+1)/2^k], halved
+/// until each fits, each at the level this host's planner chooses for it.
+/// A piece's power coefficients are computed exactly from the line's and
+/// rounded once to 2^-16 steps: within 2^-15 steps of the line, which the
+/// engine's allowance for rounding before stepping covers, so every piece
+/// keeps the line's tolerance (docs/protocol.md, "Prepared curves"). Each
+/// piece starts where the previous one ended, or one step from it where the
+/// two roundings fall either side of a half (the device joins them with a
+/// one-step straight move). Other commands are kept; labels gain ", piece j
+/// of n"; layers follow their first command. Throws EngineError naming the
+/// line when 16 halvings do not make it fit.
+void SplitForSixtyFourBitTables(StreamJob* job);
+
 /// `fdsurf stream --hidden remove`: the visible pieces of a drawing as a
 /// flat drawing of Bézier curves, which BuildStreamJob(set, options,
 /// machine, units) streams like any file's curves (CURVE commands, straight
