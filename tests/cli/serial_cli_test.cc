@@ -59,11 +59,13 @@ class SerialCli : public ::testing::Test {
   }
 
   // Starts the fixture with `options` and waits for its "ready".
-  void StartDevice(const std::string& options) {
+  // `binary`: the fixture built as the Arduino Uno's firmware is
+  // (FDSURF_PTY_DEVICE_NARROW), or as a full device.
+  void StartDevice(const std::string& options, const char* binary = FDSURF_PTY_DEVICE) {
     const std::string ready = (dir_ / "ready").string();
     // A second fixture in one test: the first one's "ready" must not count.
     std::filesystem::remove(ready);
-    const std::string command = std::string("exec '") + FDSURF_PTY_DEVICE + "' --link '" + link_ +
+    const std::string command = std::string("exec '") + binary + "' --link '" + link_ +
                                 "' --report '" + (dir_ / "report").string() +
                                 "' --time-limit-s 40 " + options + " >'" + ready + "'";
     device_ = fork();
@@ -529,6 +531,32 @@ TEST_F(SerialCli, StreamsAJobThatTheDeviceExecutesOnce) {
   EXPECT_EQ(report["idle"], "1");
   EXPECT_EQ(report["pen_down"], "0");
   EXPECT_NE(report["steps_x"], "0");
+}
+
+// A device built as the Arduino Uno's firmware (no planner, 64-bit tables
+// only) takes the job planned on the host once the lines its tables cannot
+// hold are sent in pieces: every command accepted and executed, more of them
+// than a full device is sent, and about the same points drawn.
+TEST_F(SerialCli, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
+  StartDevice("--speedup 20");
+  const Result full = Stream("--prepare-on-host");
+  ASSERT_EQ(full.exit_code, 0) << full.err;
+  auto whole = StopDevice();
+  StartDevice("--speedup 20", FDSURF_PTY_DEVICE_NARROW);
+  const Result narrow = Stream("--prepare-on-host");
+  ASSERT_EQ(narrow.exit_code, 0) << narrow.err;
+  auto pieces = StopDevice();
+  EXPECT_GT(std::stoi(pieces["executed"]), std::stoi(whole["executed"]));
+  EXPECT_EQ(pieces["accepted"], pieces["executed"]);
+  EXPECT_EQ(pieces["idle"], "1");
+  EXPECT_EQ(pieces["pen_down"], "0");
+  const double drawn = std::stod(pieces["drawn_points"]);
+  EXPECT_NEAR(drawn, std::stod(whole["drawn_points"]), 0.01 * drawn);
+  // Without the host's planning the same device says what it needs.
+  StartDevice("--speedup 20", FDSURF_PTY_DEVICE_NARROW);
+  const Result patches = Stream();
+  EXPECT_EQ(patches.exit_code, 3) << patches.err;
+  EXPECT_NE(patches.err.find("--prepare-on-host"), std::string::npos) << patches.err;
 }
 
 // Opening a Mega's port resets it; the bootloader ignores the line 1-2 s.
