@@ -76,7 +76,15 @@ class PortOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
 #ifndef FDSURF_SIZE_DEVICE_FRAME_BYTES
 #define FDSURF_SIZE_DEVICE_FRAME_BYTES protocol::kMaxFrameBytes
 #endif
-device::Device<2, 4, 256, device::SingleThreadLock, FDSURF_SIZE_DEVICE_FRAME_BYTES> g_device(40000);
+#ifndef FDSURF_SIZE_DEVICE_QUEUE
+#define FDSURF_SIZE_DEVICE_QUEUE 4
+#endif
+#ifndef FDSURF_SIZE_DEVICE_LOOKAHEAD
+#define FDSURF_SIZE_DEVICE_LOOKAHEAD 256
+#endif
+device::Device<2, FDSURF_SIZE_DEVICE_QUEUE, FDSURF_SIZE_DEVICE_LOOKAHEAD, device::SingleThreadLock,
+               FDSURF_SIZE_DEVICE_FRAME_BYTES>
+    g_device(40000);
 UartTransport g_transport;
 PortOutputs g_outputs;
 

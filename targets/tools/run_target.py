@@ -110,6 +110,7 @@ def sizes(args, build):
         rows.append((group, t - base[0], d - base[1], b - base[2]))
     t, d, b = measure("image")
     rows.append(("test-image", t, d, b))
+    rows.append(("baseline", *base))  # the port alone: a group's image is it plus the group
     return rows
 
 

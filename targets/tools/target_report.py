@@ -131,6 +131,27 @@ def main():
                  for x in (full, lean)]
         saved = "–" if full is None or lean is None else f"{full[0] + full[1] - lean[0] - lean[1]:,}"
         print(f"| {t} | {cells[0]} | {cells[1]} | {saved} |")
+    print()
+
+    # The same without the planner, sized as the Arduino Uno would hold it
+    # (size/device_uno.cc: 2 queued commands, a 64-entry lookahead), as whole
+    # images (the group plus the port alone) against the ATmega328P: 32,256
+    # bytes of flash under a 512-byte boot loader (Optiboot), 2,048 of RAM.
+    print("### The device firmware in the Arduino Uno's configuration (bytes)\n")
+    print("| target | flash (text + data) | static RAM (data + bss) | ATmega328P: flash left "
+          "| RAM left for the stack |")
+    print("|---|---|---|---|---|")
+    for t in present:
+        uno = sizes.get((t, "device_uno"))
+        base = sizes.get((t, "baseline"))
+        if uno is None or base is None:
+            continue
+        flash = uno[0] + uno[1] + base[0] + base[1]
+        ram = uno[1] + uno[2] + base[1] + base[2]
+        if t == "atmega328p":
+            print(f"| {t} | {flash:,} | {ram:,} | {32256 - flash:,} | {2048 - ram:,} |")
+        else:
+            print(f"| {t} | {flash:,} | {ram:,} | – | – |")
 
 
 main()

@@ -344,7 +344,16 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
     }
   }
   StreamJob fitted = job;
-  if ((hello.features & protocol::kFeature64BitTables) != 0) SplitForSixtyFourBitTables(&fitted);
+  if ((hello.features & protocol::kFeature64BitTables) != 0) {
+    SplitForSixtyFourBitTables(&fitted);
+    const std::size_t more = fitted.commands.size() - job.commands.size();
+    if (more > 0 && !o.quiet) {
+      std::fprintf(stderr,
+                   "fdsurf: note: %s steps 64-bit tables only: %zu more commands send the lines "
+                   "it could not hold in pieces\n",
+                   device.c_str(), more);
+    }
+  }
   const std::uint32_t tick_hz = hello.tick_hz;
   if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return fitted;
   fitted.config.max_rate = std::min(job.config.max_rate, tick_hz);
