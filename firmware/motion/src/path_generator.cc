@@ -387,8 +387,9 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
 // goes from where the machine is to a point inside the travel. The machine
 // is only ever where an accepted command took it, inside a travel of at most
 // kMaxPlannableTravelSteps (TravelPlannable, also checked for each CONFIG),
-// so the move's coefficients are at most that on every axis, and the planner
-// accepts every such line (it is monotone in the coefficients' magnitudes;
+// so the move is at most that long on every axis. StraightMoveCursor steps
+// any such move in 64 bits (its values stay below 2^55), and the planner
+// would accept it too (it is monotone in the coefficients' magnitudes;
 // ValidateCommand.EveryMoveInsideTheLargestTravelIsPlannable checks the
 // largest). So the start of a command needs no check of its own.
 template <int kDims>

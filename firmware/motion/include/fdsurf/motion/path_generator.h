@@ -91,8 +91,8 @@ struct ValidationWork {
 /// smallest L at which one step of 2^-L moves at most one step per axis,
 /// |c| ≤ 2^(16+L). That is the level the planner chooses for a line (a line
 /// has no second difference, so its chord test passes at every level), so
-/// moves are set up by PrepareAdaptiveCurveAtLevel at it, with the same bits
-/// and without the planner's search and wide integers.
+/// StraightMoveCursor steps moves at it, with the adaptive cursor's bits and
+/// without the planner's search and wide integers.
 template <int kDims>
 int StraightMoveLevel(const PowerCurve1 (&line)[kDims]);
 
