@@ -408,9 +408,11 @@ TEST(SimulatedPlotter, DrawsTheSameWhenTheHostPlansTheLines) {
 }
 
 // Whether a device of 64-bit tables (FDSURF_DEVICE_WIDE_TABLES=0) takes a
-// PREPARED_CURVE: its own check, relative to the first point, at its level.
-bool FitsSixtyFourBits(const protocol::PreparedCurveCommand& curve) {
+// PREPARED_CURVE: its own checks, the table relative to the first point at
+// the line's level, and the hull inside the travel.
+bool FitsSixtyFourBits(const protocol::PreparedCurveCommand& curve, const std::int32_t* travel) {
   PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
+  if (!motion::HullWithinTravel(line, travel)) return false;
   PowerCurve1 relative[2];
   std::int32_t first[2];
   motion::RelativeToFirstPoint(line, relative, first);
@@ -433,7 +435,7 @@ TEST(SimulatedPlotter, ASixtyFourBitDeviceGetsLongLinesInPiecesThatKeepTheTolera
   for (const protocol::Command& command : job.commands) {
     if (command.type != protocol::MessageType::kPreparedCurve) continue;
     ++lines;
-    too_wide += FitsSixtyFourBits(command.body.prepared_curve) ? 0 : 1;
+    too_wide += FitsSixtyFourBits(command.body.prepared_curve, job.config.travel_steps) ? 0 : 1;
   }
   host::StreamJob split = job;
   host::SplitForSixtyFourBitTables(&split);
@@ -443,7 +445,8 @@ TEST(SimulatedPlotter, ASixtyFourBitDeviceGetsLongLinesInPiecesThatKeepTheTolera
     const protocol::Command& command = split.commands[k];
     if (command.type != protocol::MessageType::kPreparedCurve) continue;
     ++pieces;
-    EXPECT_TRUE(FitsSixtyFourBits(command.body.prepared_curve)) << split.labels[k];
+    EXPECT_TRUE(FitsSixtyFourBits(command.body.prepared_curve, split.config.travel_steps))
+        << split.labels[k];
   }
   std::printf("%zu of %zu lines split, into %zu pieces in all\n", too_wide, lines,
               pieces - (lines - too_wide));

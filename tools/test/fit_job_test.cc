@@ -12,6 +12,7 @@
 #include "../fdsurf/stream_command.h"
 #include "fdsurf/adaptive.h"
 #include "fdsurf/host/stream.h"
+#include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/messages.h"
 
 namespace fdsurf::host {
@@ -29,6 +30,8 @@ StreamJob JobOf(protocol::MessageType type) {
   job.config.axes = 2;
   job.config.max_rate = 1000;
   job.config.travel_rate = 1000;
+  job.config.travel_steps[0] = 20000;
+  job.config.travel_steps[1] = 20000;
   job.commands = {OfType(protocol::MessageType::kConfig), OfType(type)};
   job.labels = {"the machine configuration", "the drawing"};
   return job;
@@ -106,6 +109,52 @@ TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
   EXPECT_EQ(pieces.commands[1].body.prepared_curve.power[0].c[3], curve.power[0].c[3]);
   const PowerCurve1& last = pieces.commands.back().body.prepared_curve.power[1];
   EXPECT_EQ(last.c[0] + last.c[1] + last.c[2] + last.c[3], (2000 - 700 + 50) << 16);
+}
+
+// Such a device does not halve a line whose Bernstein hull crosses the
+// travel's edge (it refuses it), so the host does: a parabola that touches
+// x = 0 at u = 1/2 from inside is sent as pieces whose hulls are inside.
+TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentALineGrazingTheEdgeInPieces) {
+  StreamOptions options;
+  options.quiet = true;
+  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
+  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
+  curve.dims = 2;
+  curve.tolerance_q8 = 256;
+  // x(u) = 400u² − 400u + 100: 100 at both ends, 0 at u = 1/2.
+  curve.power[0] = PowerCurve1{{0, std::int64_t{400} << 16, std::int64_t{-400} << 16, 100 << 16}};
+  curve.power[1] = PowerCurve1{{0, 0, std::int64_t{50} << 16, 50 << 16}};
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = curve.tolerance_q8;
+  const PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
+  PreparedAdaptiveCurve<2> planned;
+  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
+  curve.level = planned.finest_level;
+  ASSERT_FALSE(motion::HullWithinTravel(line, job.config.travel_steps));
+  std::uint8_t detail = 0;
+  ASSERT_EQ(motion::ValidateCommand<2>(job.commands[1], job.config, &detail),
+            protocol::ErrorCode::kNone);  // a full device halves it and takes it
+
+  const StreamJob pieces = FitJobToDevice(
+      job, Hello(protocol::kFeaturePreparedCurves | protocol::kFeature64BitTables), "d", options);
+  ASSERT_GE(pieces.commands.size(), 3u);  // the CONFIG and two pieces at least
+  for (std::size_t k = 1; k < pieces.commands.size(); ++k) {
+    const protocol::PreparedCurveCommand& piece = pieces.commands[k].body.prepared_curve;
+    const PowerCurve1 power[2] = {piece.power[0], piece.power[1]};
+    EXPECT_TRUE(motion::HullWithinTravel(power, job.config.travel_steps)) << k;
+  }
+  // One step further left the line leaves the travel: no piece can pass.
+  curve.power[0].c[3] -= std::int64_t{1} << 16;
+  try {
+    (void)FitJobToDevice(
+        job, Hello(protocol::kFeaturePreparedCurves | protocol::kFeature64BitTables), "d", options);
+    ADD_FAILURE() << "a line leaving the travel was split for the device";
+  } catch (const EngineError& e) {
+    EXPECT_NE(std::string(e.what()).find("the drawing: its hull crosses the edge of the travel"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

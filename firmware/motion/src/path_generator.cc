@@ -50,6 +50,7 @@ uint64_t Offset(int64_t value, int shift) {
   return kHullOffset + (static_cast<uint64_t>(value) << shift);  // two's complement: exact
 }
 
+#if FDSURF_DEVICE_WIDE_TABLES
 // The piece's classification against [low3, high3), each of its
 // coefficients within `slack` of the exact one: inside when every exact
 // coefficient is, outside when an end (a point of the curve) is.
@@ -61,6 +62,7 @@ Hull Classify(const uint64_t (&hull)[4], uint64_t low3, uint64_t high3, uint64_t
   }
   return Hull::kInside;
 }
+#endif  // FDSURF_DEVICE_WIDE_TABLES
 
 }  // namespace
 
@@ -110,6 +112,7 @@ int TravelHullOf(const int64_t (&k)[4], int32_t travel, uint64_t (&hull)[4], uin
 
 namespace {
 
+#if FDSURF_DEVICE_WIDE_TABLES
 // Whether the cubic a·u³ + b·u² + c·u + d (2^-16 steps) stays in
 // [−1/2, T + 1/2) for u ∈ [0, 1]. Pieces are taken left to right; one whose
 // hull crosses the boundary is halved, one whose hull is inside is done, and
@@ -158,30 +161,47 @@ bool AxisWithinTravel(const int64_t (&k)[4], int32_t travel, ValidationWork* wor
       internal::KeepHalfOfHull(hull, ((j >> bit) & 1u) != 0);
   }
 }
+#endif  // FDSURF_DEVICE_WIDE_TABLES
+
+// The travel check's first test, on one axis: the curve stays in the convex
+// hull of its Bernstein coefficients b0..b3, and a value in [−1/2, T + 1/2)
+// rounds into [0, T]; tested as 3·b_i, which are integers: 3d, 3d + c,
+// 3d + 2c + b, 3(a + b + c + d). Coefficients are below 2^49 (the planner
+// checked), so nothing overflows. *end_outside: an end (a point of the
+// curve) is outside, so the curve is.
+bool AxisHullWithinTravel(const int64_t (&k)[4], int32_t travel, bool* end_outside) {
+  int64_t hull[4];
+  BernsteinTimes3(k, hull);
+  const int64_t high3 = High3(travel);
+  const auto outside = [&](int64_t value) { return value < kLow3 || value >= high3; };
+  *end_outside = outside(hull[0]) || outside(hull[3]);
+  return !outside(hull[0]) && !outside(hull[1]) && !outside(hull[2]) && !outside(hull[3]);
+}
 
 // Whether every point the stepper can emit for this curve lies in
-// [0, travel] on every axis. The curve stays in the convex hull of its
-// Bernstein coefficients b0..b3, and a value in [−1/2, T + 1/2) rounds into
-// [0, T]; tested as 3·b_i, which are integers: 3d, 3d + c, 3d + 2c + b,
-// 3(a + b + c + d). Almost every line passes this at once; an axis whose
-// hull crosses the boundary is decided by AxisWithinTravel. Coefficients
-// are below 2^49 (the planner checked), so nothing overflows.
+// [0, travel] on every axis. Almost every line passes the hull test at
+// once. An axis whose hull crosses the boundary is decided by
+// AxisWithinTravel; a device of 64-bit tables refuses it instead, as
+// undecided unless an end is outside (its host splits such lines:
+// HullWithinTravel).
 template <int kDims>
 bool WithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel, uint8_t* detail,
                   ValidationWork* work) {
   for (int c = 0; c < kDims; ++c) {
-    const int64_t(&k)[4] = curve[c].c;
-    int64_t hull[4];
-    BernsteinTimes3(k, hull);
-    bool crossing = false;
-    for (const int64_t value : hull)
-      crossing = crossing || value < kLow3 || value >= High3(travel[c]);
-    if (!crossing) continue;
+    bool end_outside = false;
+    if (AxisHullWithinTravel(curve[c].c, travel[c], &end_outside)) continue;
+#if FDSURF_DEVICE_WIDE_TABLES
+    (void)end_outside;
     bool undecided = false;
-    if (!AxisWithinTravel(k, travel[c], work, &undecided)) {
+    if (!AxisWithinTravel(curve[c].c, travel[c], work, &undecided)) {
       *detail = static_cast<uint8_t>(c | (undecided ? kUndecidedTravel : 0));
       return false;
     }
+#else
+    (void)work;
+    *detail = static_cast<uint8_t>(c | (end_outside ? 0 : kUndecidedTravel));
+    return false;
+#endif
   }
   return true;
 }
@@ -300,6 +320,15 @@ void ReverseCurve(PowerCurve1 (&curve)[kDims]) {
     curve[c].c[2] = -(3 * a + 2 * b + cc);
     curve[c].c[3] = a + b + cc + d;
   }
+}
+
+template <int kDims>
+bool HullWithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel) {
+  for (int c = 0; c < kDims; ++c) {
+    bool end_outside = false;
+    if (!AxisHullWithinTravel(curve[c].c, travel[c], &end_outside)) return false;
+  }
+  return true;
 }
 
 template <int kDims>
@@ -698,6 +727,8 @@ template void ReverseCurve<2>(PowerCurve1 (&)[2]);
 template void ReverseCurve<3>(PowerCurve1 (&)[3]);
 template void RelativeToFirstPoint<2>(const PowerCurve1 (&)[2], PowerCurve1 (&)[2], int32_t (&)[2]);
 template void RelativeToFirstPoint<3>(const PowerCurve1 (&)[3], PowerCurve1 (&)[3], int32_t (&)[3]);
+template bool HullWithinTravel<2>(const PowerCurve1 (&)[2], const int32_t*);
+template bool HullWithinTravel<3>(const PowerCurve1 (&)[3], const int32_t*);
 template class StraightMoveCursor<2>;
 template class StraightMoveCursor<3>;
 template int StraightMoveLevel<2>(const PowerCurve1 (&)[2]);

@@ -234,8 +234,9 @@ Status NarrowLevelOf(const PowerCurve1 (&piece)[kDims], std::uint32_t tolerance_
 template <int kDims>
 class Splitter {
  public:
-  Splitter(const protocol::PreparedCurveCommand& line, const std::string& label)
-      : line_(line), label_(label) {
+  Splitter(const protocol::PreparedCurveCommand& line, const std::int32_t* travel,
+           const std::string& label)
+      : line_(line), travel_(travel), label_(label) {
     for (int c = 0; c < kDims; ++c) whole_[c] = line.power[c];
   }
 
@@ -246,7 +247,8 @@ class Splitter {
   }
 
  private:
-  bool Fits(const PowerCurve1 (&piece)[kDims], int level) const {
+  FDSURF_NODISCARD bool Fits(const PowerCurve1 (&piece)[kDims], int level) const {
+    if (!motion::HullWithinTravel(piece, travel_)) return false;
     PowerCurve1 relative[kDims];
     std::int32_t first[kDims];
     motion::RelativeToFirstPoint(piece, relative, first);
@@ -262,7 +264,10 @@ class Splitter {
     PieceOf(whole_, k, i, piece);
     int level = 0;
     const Status status = NarrowLevelOf(piece, line_.tolerance_q8, &level);
-    if (status == Status::kOk) {
+    // A hull that crosses the travel's edge is refused by such a device
+    // (motion::HullWithinTravel): halved like a table that does not fit.
+    const bool inside = motion::HullWithinTravel(piece, travel_);
+    if (status == Status::kOk && inside) {
       protocol::PreparedCurveCommand command = line_;
       command.level = static_cast<std::uint8_t>(level);
       for (int c = 0; c < kDims; ++c) command.power[c] = piece[c];
@@ -270,14 +275,17 @@ class Splitter {
       return;
     }
     if ((status != Status::kOk && status != Status::kPrecisionUnreachable) || k == kMaxSplitDepth) {
-      throw EngineError(label_ + ": " + StatusMessage(status) + " (a piece of 1/2^" +
-                        std::to_string(k) + " of it, for a device of 64-bit tables)");
+      const std::string why =
+          status != Status::kOk ? StatusMessage(status) : "its hull crosses the edge of the travel";
+      throw EngineError(label_ + ": " + why + " (a piece of 1/2^" + std::to_string(k) +
+                        " of it, for a device of 64-bit tables)");
     }
     Split(k + 1, 2 * i);
     Split(k + 1, 2 * i + 1);
   }
 
   const protocol::PreparedCurveCommand& line_;
+  const std::int32_t* travel_;
   const std::string& label_;
   PowerCurve1 whole_[kDims];
   std::vector<protocol::PreparedCurveCommand> pieces_;
@@ -297,7 +305,8 @@ void SplitEach(StreamJob* job) {
       continue;
     }
     const std::vector<protocol::PreparedCurveCommand> pieces =
-        Splitter<kDims>(command.body.prepared_curve, job->labels[index]).Pieces();
+        Splitter<kDims>(command.body.prepared_curve, job->config.travel_steps, job->labels[index])
+            .Pieces();
     for (std::size_t j = 0; j < pieces.size(); ++j) {
       Command piece = command;
       piece.body.prepared_curve = pieces[j];

@@ -51,6 +51,8 @@ constexpr int32_t kMaxPlannableTravelSteps = int32_t{1} << 26;
 /// the boundary: halvings at most kHullMaxDepth deep, at most kHullTestBudget
 /// hull tests. A line that is not proven inside within it is refused with
 /// detail = axis | kUndecidedTravel (docs/motion.md, "Validation on arrival").
+/// A device of 64-bit tables does not halve: it refuses every line whose
+/// hull crosses the boundary (HullWithinTravel), and its host splits them.
 constexpr int kHullMaxDepth = 20;
 constexpr uint16_t kHullTestBudget = 64;
 constexpr uint8_t kUndecidedTravel = 0x80;
@@ -106,6 +108,16 @@ int StraightMoveLevel(const PowerCurve1 (&line)[kDims]);
 template <int kDims>
 void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relative)[kDims],
                           int32_t (&first)[kDims]);
+
+/// The travel check's first test: whether, on every axis, the Bernstein
+/// hull of `curve` (2^-16 steps) lies in [−1/2, travel + 1/2), so that every
+/// point the stepper emits is in [0, travel]. All a device of 64-bit tables
+/// checks (FDSURF_DEVICE_WIDE_TABLES=0): a line that fails it is refused,
+/// kOutOfTravel with detail axis | kUndecidedTravel unless an end of the
+/// line is outside. So its host sends such a line in pieces that pass
+/// (host::SplitForSixtyFourBitTables).
+template <int kDims>
+bool HullWithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel);
 
 /// The points of a straight move from `from` to `to` (steps), exactly as
 /// the adaptive cursor emits them for the move's line at its

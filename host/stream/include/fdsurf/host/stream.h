@@ -201,8 +201,10 @@ void PrepareOnHost(StreamJob* job);
 /// protocol::kFeature64BitTables, the Arduino Uno): every PREPARED_CURVE whose
 /// table, relative to its first point, does not fit the 64-bit accumulator
 /// at its level (the device's own check, PrepareAdaptiveCurveAtLevel's
-/// 64-bit form) is replaced by its pieces over [i/2^k, (i+1)/2^k], halved
-/// until each fits, each at the level this host's planner chooses for it.
+/// 64-bit form), or whose Bernstein hull crosses the edge of the travel
+/// (such a device does not halve it: motion::HullWithinTravel), is replaced
+/// by its pieces over [i/2^k, (i+1)/2^k], halved until each passes both,
+/// each at the level this host's planner chooses for it.
 /// A piece's power coefficients are computed exactly from the line's and
 /// rounded once to 2^-16 steps: within 2^-15 steps of the line, which the
 /// engine's allowance for rounding before stepping covers, so every piece
