@@ -39,7 +39,8 @@ constexpr uint64_t kHullLimit = uint64_t{1} << 61;
 
 // 3·b_i, the Bernstein coefficients times 3 (integers): 3d, 3d + c,
 // 3d + 2c + b, 3(a + b + c + d); below 2^53 for coefficients below 2^49.
-void BernsteinTimes3(const int64_t (&k)[4], int64_t (&b3)[4]) {
+// Out of line on AVR: the hull test and the halving's set-up share it.
+FDSURF_OUT_OF_LINE_ON_AVR void BernsteinTimes3(const int64_t (&k)[4], int64_t (&b3)[4]) {
   b3[0] = 3 * k[3];
   b3[1] = b3[0] + k[2];
   b3[2] = b3[1] + k[2] + k[1];
@@ -173,9 +174,14 @@ bool AxisHullWithinTravel(const int64_t (&k)[4], int32_t travel, bool* end_outsi
   int64_t hull[4];
   BernsteinTimes3(k, hull);
   const int64_t high3 = High3(travel);
-  const auto outside = [&](int64_t value) { return value < kLow3 || value >= high3; };
-  *end_outside = outside(hull[0]) || outside(hull[3]);
-  return !outside(hull[0]) && !outside(hull[1]) && !outside(hull[2]) && !outside(hull[3]);
+  bool inside = true;
+  *end_outside = false;
+  for (int i = 0; i < 4; ++i) {
+    const bool outside = hull[i] < kLow3 || hull[i] >= high3;
+    inside = inside && !outside;
+    *end_outside = *end_outside || (outside && (i == 0 || i == 3));
+  }
+  return inside;
 }
 
 // Whether every point the stepper can emit for this curve lies in
