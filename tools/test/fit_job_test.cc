@@ -111,6 +111,55 @@ TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
   EXPECT_EQ(last.c[0] + last.c[1] + last.c[2] + last.c[3], (2000 - 700 + 50) << 16);
 }
 
+// The same for a 3-D job: every piece of a long 3-D line passes the device's
+// checks, and the pieces run from the line's start to its end on every axis.
+TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLong3DLinesInPieces) {
+  StreamOptions options;
+  options.quiet = true;
+  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
+  job.config.axes = 3;
+  job.config.travel_steps[2] = 20000;
+  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
+  curve.dims = 3;
+  curve.tolerance_q8 = 256;
+  curve.power[0] = PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}};
+  curve.power[1] = PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}};
+  curve.power[2] = PowerCurve1{
+      {std::int64_t{300} << 16, std::int64_t{-900} << 16, std::int64_t{4000} << 16, 10 << 16}};
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = curve.tolerance_q8;
+  const PowerCurve1 line[3] = {curve.power[0], curve.power[1], curve.power[2]};
+  PreparedAdaptiveCurve<3> planned;
+  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
+  curve.level = planned.finest_level;
+  protocol::HelloReply hello =
+      Hello(protocol::kFeaturePreparedCurves | protocol::kFeature64BitTables);
+  hello.max_axes = 3;
+  const StreamJob pieces = FitJobToDevice(job, hello, "d", options);
+  ASSERT_GT(pieces.commands.size(), 3u);
+  for (std::size_t k = 1; k < pieces.commands.size(); ++k) {
+    const protocol::PreparedCurveCommand& piece = pieces.commands[k].body.prepared_curve;
+    ASSERT_EQ(piece.dims, 3);
+    PowerCurve1 power[3] = {piece.power[0], piece.power[1], piece.power[2]};
+    PowerCurve1 relative[3];
+    std::int32_t first[3];
+    motion::RelativeToFirstPoint(power, relative, first);
+    PreparedAdaptiveCurve<3, std::int64_t> table;
+    EXPECT_EQ(PrepareAdaptiveCurveAtLevel(relative, piece.level, settings, &table), Status::kOk)
+        << k;
+    EXPECT_TRUE(motion::HullWithinTravel(power, job.config.travel_steps)) << k;
+  }
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(pieces.commands[1].body.prepared_curve.power[c].c[3], curve.power[c].c[3]) << c;
+    const PowerCurve1& last = pieces.commands.back().body.prepared_curve.power[c];
+    const PowerCurve1& whole = curve.power[c];
+    EXPECT_EQ(last.c[0] + last.c[1] + last.c[2] + last.c[3],
+              whole.c[0] + whole.c[1] + whole.c[2] + whole.c[3])
+        << c;
+  }
+}
+
 // Such a device does not halve a line whose Bernstein hull crosses the
 // travel's edge (it refuses it), so the host does: a parabola that touches
 // x = 0 at u = 1/2 from inside is sent as pieces whose hulls are inside.
