@@ -89,6 +89,20 @@ std::vector<ReferenceLine> Reference(const host::StreamJob& job) {
   return lines;
 }
 
+// Every drawn point and chord of `run` near the exact curves of `job`'s
+// teapot (an independent dense evaluation), no curve left out, and the
+// motion within the limits; returns the motion report.
+MotionReport ExpectTheTeapotWithinTheToleranceAndTheLimits(const Streamed& run,
+                                                           const host::StreamJob& job) {
+  const DrawingComparison comparison = CompareDrawing(run.drawn, Reference(job), 2);
+  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
+  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
+  EXPECT_GT(comparison.drawn_points, 10000u);
+  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
+  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+  return motion;
+}
+
 // The fault-free run, shared by the comparisons below.
 const Streamed& Baseline() {
   static const Streamed run = Stream(SmallTeapotJob(), PlotterOptions{});
@@ -287,13 +301,7 @@ TEST(SimulatedPlotter, DrawsTheTeapotWithinTheToleranceAndTheLimits) {
   ASSERT_TRUE(run.result.finished) << run.result.error;
   EXPECT_EQ(run.result.executed, job.commands.size());
   EXPECT_EQ(run.result.host.retransmitted, 0u);
-  const DrawingComparison comparison = CompareDrawing(run.drawn, Reference(job), 2);
-  // Every drawn point and chord near the exact curves, and no curve left out.
-  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
-  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
-  EXPECT_GT(comparison.drawn_points, 10000u);
-  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
-  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+  const MotionReport motion = ExpectTheTeapotWithinTheToleranceAndTheLimits(run, job);
   EXPECT_LE(motion.max_speed, job.config.max_rate * 1.01);
   // And it does get up to speed: within 15 % of it, where the turn caps
   // hold it below the limit on the small teapot's curves (measured 0.85).
@@ -456,12 +464,7 @@ TEST(SimulatedPlotter, ASixtyFourBitDeviceGetsLongLinesInPiecesThatKeepTheTolera
   const Streamed run = Stream(split, PlotterOptions{});
   ASSERT_TRUE(run.result.finished) << run.result.error;
   EXPECT_EQ(run.result.executed, split.commands.size());
-  const DrawingComparison comparison = CompareDrawing(run.drawn, Reference(job), 2);
-  EXPECT_LE(comparison.max_deviation, job.tolerance_steps + 0.005);
-  EXPECT_LE(comparison.max_gap, job.tolerance_steps + 0.005);
-  EXPECT_GT(comparison.drawn_points, 10000u);
-  const MotionReport motion = CheckMotion(run.steps, run.pens, LimitsOf(job));
-  EXPECT_EQ(motion.violations, 0u) << motion.first_violation;
+  ExpectTheTeapotWithinTheToleranceAndTheLimits(run, job);
 }
 
 // The cost model charges a prepared line the check at its level (43,014

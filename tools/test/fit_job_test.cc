@@ -49,6 +49,30 @@ protocol::HelloReply Hello(std::uint8_t features) {
   return hello;
 }
 
+AdaptiveSettings StepExact(std::uint32_t tolerance_q8) {
+  AdaptiveSettings settings;
+  settings.mode = AdaptiveMode::kStepExact;
+  settings.tolerance_q8 = tolerance_q8;
+  return settings;
+}
+
+// A job of one PREPARED_CURVE: `line` at a tolerance of one step, at the
+// level this host's planner chooses, on a travel of 20,000 steps per axis.
+template <int kDims>
+StreamJob PreparedJobOf(const PowerCurve1 (&line)[kDims]) {
+  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
+  job.config.axes = kDims;
+  job.config.travel_steps[2] = kDims == 3 ? 20000 : 0;
+  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
+  curve.dims = kDims;
+  curve.tolerance_q8 = 256;
+  for (int c = 0; c < kDims; ++c) curve.power[c] = line[c];
+  PreparedAdaptiveCurve<kDims> planned;
+  EXPECT_EQ(PrepareAdaptiveCurve(line, StepExact(curve.tolerance_q8), &planned), Status::kOk);
+  curve.level = planned.finest_level;
+  return job;
+}
+
 TEST(FitJobToDevice, ADeviceWithoutAPlannerIsGivenPreparedCurvesOnly) {
   StreamOptions options;
   options.quiet = true;
@@ -79,20 +103,14 @@ TEST(FitJobToDevice, ADeviceWithoutAPlannerIsGivenPreparedCurvesOnly) {
 TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
   StreamOptions options;
   options.quiet = true;
-  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
-  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
-  curve.dims = 2;
-  curve.tolerance_q8 = 256;
-  curve.power[0] = PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}};
-  curve.power[1] = PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}};
-  AdaptiveSettings settings;
-  settings.mode = AdaptiveMode::kStepExact;
-  settings.tolerance_q8 = curve.tolerance_q8;
-  const PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
+  const PowerCurve1 line[2] = {
+      PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}},
+      PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}}};
+  const StreamJob job = PreparedJobOf(line);
+  const protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
   PreparedAdaptiveCurve<2> planned;
-  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
+  ASSERT_EQ(PrepareAdaptiveCurve(line, StepExact(curve.tolerance_q8), &planned), Status::kOk);
   ASSERT_EQ(planned.format.acc_bits, 128);
-  curve.level = planned.finest_level;
 
   const StreamJob whole =
       FitJobToDevice(job, Hello(protocol::kFeaturePreparedCurves), "d", options);
@@ -116,23 +134,14 @@ TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
 TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLong3DLinesInPieces) {
   StreamOptions options;
   options.quiet = true;
-  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
-  job.config.axes = 3;
-  job.config.travel_steps[2] = 20000;
-  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
-  curve.dims = 3;
-  curve.tolerance_q8 = 256;
-  curve.power[0] = PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}};
-  curve.power[1] = PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}};
-  curve.power[2] = PowerCurve1{
-      {std::int64_t{300} << 16, std::int64_t{-900} << 16, std::int64_t{4000} << 16, 10 << 16}};
-  AdaptiveSettings settings;
-  settings.mode = AdaptiveMode::kStepExact;
-  settings.tolerance_q8 = curve.tolerance_q8;
-  const PowerCurve1 line[3] = {curve.power[0], curve.power[1], curve.power[2]};
-  PreparedAdaptiveCurve<3> planned;
-  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
-  curve.level = planned.finest_level;
+  const PowerCurve1 line[3] = {
+      PowerCurve1{{0, std::int64_t{500} << 16, std::int64_t{3000} << 16, 100 << 16}},
+      PowerCurve1{{std::int64_t{-700} << 16, 0, std::int64_t{2000} << 16, 50 << 16}},
+      PowerCurve1{
+          {std::int64_t{300} << 16, std::int64_t{-900} << 16, std::int64_t{4000} << 16, 10 << 16}}};
+  const StreamJob job = PreparedJobOf(line);
+  const protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
+  const AdaptiveSettings settings = StepExact(curve.tolerance_q8);
   protocol::HelloReply hello =
       Hello(protocol::kFeaturePreparedCurves | protocol::kFeature64BitTables);
   hello.max_axes = 3;
@@ -166,20 +175,12 @@ TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentLong3DLinesInPieces) {
 TEST(FitJobToDevice, ADeviceOfSixtyFourBitTablesIsSentALineGrazingTheEdgeInPieces) {
   StreamOptions options;
   options.quiet = true;
-  StreamJob job = JobOf(protocol::MessageType::kPreparedCurve);
-  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
-  curve.dims = 2;
-  curve.tolerance_q8 = 256;
   // x(u) = 400u² − 400u + 100: 100 at both ends, 0 at u = 1/2.
-  curve.power[0] = PowerCurve1{{0, std::int64_t{400} << 16, std::int64_t{-400} << 16, 100 << 16}};
-  curve.power[1] = PowerCurve1{{0, 0, std::int64_t{50} << 16, 50 << 16}};
-  AdaptiveSettings settings;
-  settings.mode = AdaptiveMode::kStepExact;
-  settings.tolerance_q8 = curve.tolerance_q8;
-  const PowerCurve1 line[2] = {curve.power[0], curve.power[1]};
-  PreparedAdaptiveCurve<2> planned;
-  ASSERT_EQ(PrepareAdaptiveCurve(line, settings, &planned), Status::kOk);
-  curve.level = planned.finest_level;
+  const PowerCurve1 line[2] = {
+      PowerCurve1{{0, std::int64_t{400} << 16, std::int64_t{-400} << 16, 100 << 16}},
+      PowerCurve1{{0, 0, std::int64_t{50} << 16, 50 << 16}}};
+  StreamJob job = PreparedJobOf(line);
+  protocol::PreparedCurveCommand& curve = job.commands[1].body.prepared_curve;
   ASSERT_FALSE(motion::HullWithinTravel(line, job.config.travel_steps));
   std::uint8_t detail = 0;
   ASSERT_EQ(motion::ValidateCommand<2>(job.commands[1], job.config, &detail),
