@@ -189,7 +189,7 @@ std::int64_t RoundShifted(__int128 numerator, int bits) {
 
 // The piece of `line` over [i/2^k, (i+1)/2^k] as power coefficients in v
 // from 0 to 1: x(u0 + v/2^k) with u0 = i/2^k, each coefficient times 2^(3k)
-// exact in __int128 (below 2^96 for |coefficients| < 2^47 and k ≤ 16), then
+// exact in __int128 (four terms below 2^95 each for |coefficients| < 2^47 and k ≤ 16), then
 // rounded once.
 template <int kDims>
 void PieceOf(const PowerCurve1 (&line)[kDims], int k, std::uint64_t i,
