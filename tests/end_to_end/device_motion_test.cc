@@ -467,7 +467,7 @@ TEST(PathGenerator, MoveStepsThroughRoundedPointsOfTheStraightLine) {
   EXPECT_EQ(p[1], 382);
 }
 
-// A straight move is stepped by a 64-bit counter, not the adaptive cursor:
+// A straight move is stepped by a 32-bit counter, not the adaptive cursor:
 // it must emit the points the adaptive cursor emits for the move's line at
 // StraightMoveLevel (with Int128, which takes every length), at lengths from
 // 0 to 2^20 steps on the longest axis, negative and positive, and every

@@ -350,13 +350,14 @@ void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relat
 template <int kDims>
 void StraightMoveCursor<kDims>::Reset(const int32_t (&from)[kDims], const int32_t (&to)[kDims],
                                       int level) {
+  modulus_ = int32_t{1} << (level + 1);
   for (int c = 0; c < kDims; ++c) {
-    numerator_[c] = fdsurf::internal::ShiftLeft(2 * static_cast<int64_t>(from[c]) + 1, level);
-    increment_[c] = 2 * (static_cast<int64_t>(to[c]) - from[c]);
-    last_[c] = from[c];
+    point_[c] = from[c];
+    // (2·from + 1)·2^L over 2^(L+1) is from + 1/2: the rounding half.
+    remainder_[c] = int32_t{1} << level;
+    increment_[c] = 2 * (to[c] - from[c]);
   }
   remaining_ = uint32_t{1} << level;
-  shift_ = static_cast<uint8_t>(level + 1);
   started_ = false;
 }
 
@@ -364,20 +365,27 @@ template <int kDims>
 bool StraightMoveCursor<kDims>::Next(int32_t (&point)[kDims]) {
   if (!started_) {
     started_ = true;
-    for (int c = 0; c < kDims; ++c) point[c] = last_[c];
+    for (int c = 0; c < kDims; ++c) point[c] = point_[c];
     return true;
   }
   while (remaining_ > 0) {
     --remaining_;
     bool moved = false;
     for (int c = 0; c < kDims; ++c) {
-      numerator_[c] += increment_[c];
-      point[c] =
-          static_cast<int32_t>(fdsurf::internal::ShiftRightArithmetic(numerator_[c], shift_));
-      moved = moved || point[c] != last_[c];
+      // |increment| ≤ modulus, so the point moves by at most one.
+      remainder_[c] += increment_[c];
+      if (remainder_[c] >= modulus_) {
+        remainder_[c] -= modulus_;
+        ++point_[c];
+        moved = true;
+      } else if (remainder_[c] < 0) {
+        remainder_[c] += modulus_;
+        --point_[c];
+        moved = true;
+      }
     }
     if (moved) {
-      for (int c = 0; c < kDims; ++c) last_[c] = point[c];
+      for (int c = 0; c < kDims; ++c) point[c] = point_[c];
       return true;
     }
   }
@@ -423,7 +431,7 @@ ErrorCode ValidateCommand(const protocol::Command& command, const protocol::Mach
 // is only ever where an accepted command took it, inside a travel of at most
 // kMaxPlannableTravelSteps (TravelPlannable, also checked for each CONFIG),
 // so the move is at most that long on every axis. StraightMoveCursor steps
-// any such move in 64 bits (its values stay below 2^55), and the planner
+// any such move in 32 bits (its values stay below 2^28), and the planner
 // would accept it too (it is monotone in the coefficients' magnitudes;
 // ValidateCommand.EveryMoveInsideTheLargestTravelIsPlannable checks the
 // largest). So the start of a command needs no check of its own.

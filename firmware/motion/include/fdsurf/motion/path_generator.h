@@ -123,25 +123,28 @@ bool HullWithinTravel(const PowerCurve1 (&curve)[kDims], const int32_t* travel);
 /// the adaptive cursor emits them for the move's line at its
 /// StraightMoveLevel L: the distinct points round(from + (to − from)·j/2^L),
 /// halves up, j = 0 .. 2^L (at that level no step can double, so the cursor
-/// takes every j). One 64-bit addition per axis and j, at any length in the
-/// travel (|to − from| ≤ 2^26 makes every value below 2^55), so no move
-/// needs Int128.
+/// takes every j). Each is floor(((2·from + 1)·2^L + 2·(to − from)·j) /
+/// 2^(L+1)), kept as the point and the remainder, so a j is one 32-bit
+/// addition and comparison per axis: no shift, no wide integer, at any
+/// length in the travel.
 template <int kDims>
 class StraightMoveCursor {
  public:
-  /// Starts the move; `level` is StraightMoveLevel of its line.
+  /// Starts the move; `level` is StraightMoveLevel of its line, at most 29
+  /// (a move within kMaxPlannableTravelSteps has at most 26), so that
+  /// every value below stays within int32.
   void Reset(const int32_t (&from)[kDims], const int32_t (&to)[kDims], int level);
   /// The next point, the first one first; false after the last.
   bool Next(int32_t (&point)[kDims]);
 
  private:
-  // (2·from + 1)·2^L + 2·(to − from)·j: the point is this over 2^(L+1),
-  // rounded down.
-  int64_t numerator_[kDims] = {};
-  int64_t increment_[kDims] = {};
-  int32_t last_[kDims] = {};
+  // The point and the remainder of the numerator above over 2^(L+1):
+  // 0 ≤ remainder_ < modulus_ = 2^(L+1); each j adds 2·(to − from).
+  int32_t point_[kDims] = {};
+  int32_t remainder_[kDims] = {};
+  int32_t increment_[kDims] = {};
+  int32_t modulus_ = 2;
   uint32_t remaining_ = 0;  // values of j still to take
-  uint8_t shift_ = 1;       // L + 1
   bool started_ = false;
 };
 
