@@ -211,25 +211,6 @@ void PieceOf(const PowerCurve1 (&line)[kDims], int k, std::uint64_t i,
   }
 }
 
-// The level this host's planner chooses for `piece`, and whether a device of
-// 64-bit tables takes the piece at it (relative to its first point, as the
-// device steps it: motion::RelativeToFirstPoint).
-template <int kDims>
-Status NarrowLevelOf(const PowerCurve1 (&piece)[kDims], std::uint32_t tolerance_q8, int* level) {
-  AdaptiveSettings settings;
-  settings.mode = AdaptiveMode::kStepExact;
-  settings.tolerance_q8 = tolerance_q8;
-  PreparedAdaptiveCurve<kDims> planned;
-  const Status planned_status = PrepareAdaptiveCurve(piece, settings, &planned);
-  if (planned_status != Status::kOk) return planned_status;
-  *level = planned.finest_level;
-  PowerCurve1 relative[kDims];
-  std::int32_t first[kDims];
-  motion::RelativeToFirstPoint(piece, relative, first);
-  PreparedAdaptiveCurve<kDims, std::int64_t> narrow;
-  return PrepareAdaptiveCurveAtLevel(relative, *level, settings, &narrow);
-}
-
 // The pieces of one PREPARED_CURVE for a device of 64-bit tables, in order.
 template <int kDims>
 class Splitter {
@@ -238,38 +219,44 @@ class Splitter {
            const std::string& label)
       : line_(line), travel_(travel), label_(label) {
     for (int c = 0; c < kDims; ++c) whole_[c] = line.power[c];
+    settings_.mode = AdaptiveMode::kStepExact;
+    settings_.tolerance_q8 = line.tolerance_q8;
   }
 
   std::vector<protocol::PreparedCurveCommand> Pieces() {
-    if (Fits(whole_, line_.level)) return {line_};
+    if (motion::HullWithinTravel(whole_, travel_) && TableAt(whole_, line_.level) == Status::kOk) {
+      return {line_};
+    }
     Split(0, 0);
     return std::move(pieces_);
   }
 
  private:
-  FDSURF_NODISCARD bool Fits(const PowerCurve1 (&piece)[kDims], int level) const {
-    if (!motion::HullWithinTravel(piece, travel_)) return false;
+  // The device's check of the piece's table at `level`: relative to its
+  // first point, as the device steps it (motion::RelativeToFirstPoint), in
+  // 64 bits.
+  FDSURF_NODISCARD Status TableAt(const PowerCurve1 (&piece)[kDims], int level) const {
     PowerCurve1 relative[kDims];
     std::int32_t first[kDims];
     motion::RelativeToFirstPoint(piece, relative, first);
-    AdaptiveSettings settings;
-    settings.mode = AdaptiveMode::kStepExact;
-    settings.tolerance_q8 = line_.tolerance_q8;
     PreparedAdaptiveCurve<kDims, std::int64_t> narrow;
-    return PrepareAdaptiveCurveAtLevel(relative, level, settings, &narrow) == Status::kOk;
+    return PrepareAdaptiveCurveAtLevel(relative, level, settings_, &narrow);
   }
 
+  // The piece at the level this host's planner chooses for it, if the
+  // device takes it there; else its halves, or an error at the last depth.
   void Split(int k, std::uint64_t i) {
     PowerCurve1 piece[kDims];
     PieceOf(whole_, k, i, piece);
-    int level = 0;
-    const Status status = NarrowLevelOf(piece, line_.tolerance_q8, &level);
+    PreparedAdaptiveCurve<kDims> planned;
+    Status status = PrepareAdaptiveCurve(piece, settings_, &planned);
+    if (status == Status::kOk) status = TableAt(piece, planned.finest_level);
     // A hull that crosses the travel's edge is refused by such a device
     // (motion::HullWithinTravel): halved like a table that does not fit.
     const bool inside = motion::HullWithinTravel(piece, travel_);
     if (status == Status::kOk && inside) {
       protocol::PreparedCurveCommand command = line_;
-      command.level = static_cast<std::uint8_t>(level);
+      command.level = planned.finest_level;
       for (int c = 0; c < kDims; ++c) command.power[c] = piece[c];
       pieces_.push_back(command);
       return;
@@ -287,6 +274,7 @@ class Splitter {
   const protocol::PreparedCurveCommand& line_;
   const std::int32_t* travel_;
   const std::string& label_;
+  AdaptiveSettings settings_;
   PowerCurve1 whole_[kDims];
   std::vector<protocol::PreparedCurveCommand> pieces_;
 };
