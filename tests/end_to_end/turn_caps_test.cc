@@ -16,6 +16,7 @@
 #include "fdsurf/motion/motion_loop.h"
 #include "fdsurf/motion/turn_caps.h"
 #include "fdsurf/sim/checks.h"
+#include "random_strokes.h"
 
 namespace fdsurf {
 namespace {
@@ -24,126 +25,13 @@ using motion::EntryKind;
 using motion::MakeEntry;
 using motion::MotionLoop;
 
-constexpr std::uint32_t kTickHz = 40000;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kWindow = 0.02;  // CheckMotion's default
-
-struct Machine {
-  std::uint32_t rate;        // steps/s
-  std::uint32_t accel;       // path, steps/s²
-  std::uint32_t axis_accel;  // each axis, steps/s² (0: not limited)
-};
-
-motion::TickLimits TickLimitsOf(const Machine& m) {
-  motion::TickLimits limits{};
-  const motion::MotionLimits si{kTickHz, m.rate, m.accel,
-                                0,       m.rate, {m.axis_accel, m.axis_accel, 0}};
-  EXPECT_TRUE(motion::ToTickLimits(si, &limits));
-  return limits;
-}
-
-// Unit moves from the current point through `targets` (each rounded),
-// one step per axis at most.
-void AppendPath(const std::vector<std::array<double, 2>>& targets, std::array<std::int32_t, 2>* at,
-                std::vector<std::uint8_t>* moves) {
-  for (const auto& target : targets) {
-    const std::array<std::int32_t, 2> goal = {static_cast<std::int32_t>(std::lround(target[0])),
-                                              static_cast<std::int32_t>(std::lround(target[1]))};
-    while ((*at)[0] != goal[0] || (*at)[1] != goal[1]) {
-      std::int32_t delta[2];
-      for (int a = 0; a < 2; ++a) {
-        delta[a] = goal[a] > (*at)[a] ? 1 : goal[a] < (*at)[a] ? -1 : 0;
-        (*at)[a] += delta[a];
-      }
-      moves->push_back(motion::MakeMove(delta, 2));
-    }
-  }
-}
-
-// A random stroke: arcs of random radius and sweep joined by corners of
-// random angle, and straight stretches.
-std::vector<std::uint8_t> RandomStroke(std::mt19937_64& rng, std::array<std::int32_t, 2>* at) {
-  std::vector<std::uint8_t> moves;
-  std::array<double, 2> p = {static_cast<double>((*at)[0]), static_cast<double>((*at)[1])};
-  double heading = static_cast<double>(rng() % 628) / 100;
-  for (int piece = 0; piece < 12; ++piece) {
-    std::vector<std::array<double, 2>> targets;
-    const int kind = static_cast<int>(rng() % 3);
-    if (kind == 0) {  // a corner, then a straight stretch
-      heading += (static_cast<double>(rng() % 300) / 100 - 1.5);
-      const double length = 50 + static_cast<double>(rng() % 1500);
-      for (double s = 0.5; s <= length; s += 0.5) {
-        targets.push_back({p[0] + s * std::cos(heading), p[1] + s * std::sin(heading)});
-      }
-      p = targets.back();
-    } else {  // an arc
-      const double r = 15 + static_cast<double>(rng() % 2000);
-      const double sweep = (static_cast<double>(rng() % 600) / 100 + 0.2) * (rng() % 2 ? 1 : -1);
-      const double side = sweep > 0 ? 1 : -1;
-      const std::array<double, 2> centre = {p[0] - side * r * std::sin(heading),
-                                            p[1] + side * r * std::cos(heading)};
-      const double start = std::atan2(p[1] - centre[1], p[0] - centre[0]);
-      const int n = static_cast<int>(std::fabs(sweep) * r / 0.5) + 1;
-      for (int k = 1; k <= n; ++k) {
-        const double angle = start + sweep * k / n;
-        targets.push_back({centre[0] + r * std::cos(angle), centre[1] + r * std::sin(angle)});
-      }
-      heading += sweep;
-      p = targets.back();
-    }
-    AppendPath(targets, at, &moves);
-  }
-  return moves;
-}
-
-struct Drawn {
-  std::vector<hal::StepDirEvent> steps;
-  std::vector<hal::PenEvent> pens;
-  std::array<std::int32_t, 2> position{};
-  bool idle = false;
-};
-
-// Feeds the entries as a producer with pauses would (a few entries between
-// ticks, sometimes none for a while), flushing when it has nothing more, as
-// Device::Fill() does.
-Drawn Draw(const Machine& machine, const std::vector<std::uint8_t>& entries, std::mt19937_64& rng) {
-  std::vector<std::uint8_t> storage(1024);
-  MotionLoop loop(storage.data(), 1024);
-  loop.Configure(TickLimitsOf(machine));
-  Drawn drawn;
-  std::size_t next = 0;
-  std::uint64_t tick = 0;
-  std::uint64_t starving_until = 0;
-  while ((next < entries.size() || !loop.Idle()) && tick < 200'000'000) {
-    if (tick >= starving_until) {
-      const std::uint64_t feed = 1 + rng() % 4;
-      for (std::uint64_t k = 0; k < feed && next < entries.size() && !loop.Full(); ++k) {
-        EXPECT_TRUE(loop.Push(entries[next++]));
-      }
-      if (rng() % 20000 == 0) starving_until = tick + rng() % 4000;  // the host is late
-    } else {
-      (void)loop.Flush();
-    }
-    if (next == entries.size()) (void)loop.Flush();
-    const motion::TickOutput out = loop.Tick();
-    const std::uint64_t us = tick * (1'000'000 / kTickHz);
-    if (out.step_mask != 0) drawn.steps.push_back({us, out.step_mask, out.negative_mask, true});
-    if (out.pen != 0) drawn.pens.push_back({us, out.pen > 0});
-    ++tick;
-  }
-  drawn.idle = loop.Idle();
-  drawn.position = {loop.position()[0], loop.position()[1]};
-  return drawn;
-}
-
-sim::MotionLimitsSi SiLimits(const Machine& m, double axis_accel) {
-  sim::MotionLimitsSi limits;
-  limits.tick_hz = kTickHz;
-  limits.max_rate = m.rate;
-  limits.accel = m.accel;
-  limits.axis_accel = axis_accel;
-  return limits;
-}
+using test::Draw;
+using test::Drawn;
+using test::kTickHz;
+using test::Machine;
+using test::PenStrokes;
+using test::SiLimits;
+using test::TickLimitsOf;
 
 TEST(TurnCaps, RandomStrokesKeepEveryAxisWithinItsLimit) {
   std::mt19937_64 rng(15);
@@ -154,13 +42,7 @@ TEST(TurnCaps, RandomStrokesKeepEveryAxisWithinItsLimit) {
     Machine capped = machine;
     capped.axis_accel = static_cast<std::uint32_t>(machine.accel * (1.2 + (rng() % 30) / 10.0));
     std::array<std::int32_t, 2> at{0, 0};
-    std::vector<std::uint8_t> entries;
-    for (int stroke = 0; stroke < 3; ++stroke) {
-      entries.push_back(MakeEntry(EntryKind::kPenDown));
-      const std::vector<std::uint8_t> moves = RandomStroke(rng, &at);
-      entries.insert(entries.end(), moves.begin(), moves.end());
-      entries.push_back(MakeEntry(EntryKind::kPenUp));
-    }
+    const std::vector<std::uint8_t> entries = PenStrokes(rng, 3, &at);
     std::mt19937_64 feed_rng(trial);
     const Drawn drawn = Draw(capped, entries, feed_rng);
     ASSERT_TRUE(drawn.idle) << "trial " << trial;
@@ -248,6 +130,87 @@ TEST(TurnCaps, ARightAngleIsTakenWithinTheCornerCap) {
   EXPECT_LE(speed, cap);
   EXPECT_GT(speed, 0.9 * cap);  // coarsening takes at most 6 %
   std::printf("right angle: %.0f steps/s through the corner (cap %.0f)\n", speed, cap);
+}
+
+// Whether any move of `moves` (3-D unit moves), measured by turn caps with
+// `budget` and top speed `top`, gets a cap.
+bool AnyMoveCapped(std::uint32_t budget, std::uint32_t top,
+                   const std::vector<std::uint8_t>& moves) {
+  const std::uint32_t accel = 1000;
+  std::uint32_t skip[motion::TurnCaps::kChords];
+  motion::TurnCaps::SkipThresholds(budget, top, skip);
+  motion::TurnCaps caps;
+  caps.Configure(budget, accel, top, skip);
+  bool capped = false;
+  for (const std::uint8_t move : moves) {
+    const motion::TurnCaps::Final final = caps.Measure(move, motion::LengthOfMove(move));
+    capped = capped || final.capped;
+    if (caps.HasRoom()) caps.Commit(final);
+  }
+  return capped || caps.MeasureAll(false).capped;
+}
+
+// Two straight runs of m moves each way around every corner: every pair of
+// the 26 unit moves, for every chord length.
+std::vector<std::vector<std::uint8_t>> EveryCorner() {
+  std::vector<std::uint8_t> kinds;
+  for (int code = 0; code < 27; ++code) {
+    const std::int32_t delta[3] = {code % 3 - 1, code / 3 % 3 - 1, code / 9 - 1};
+    if (delta[0] != 0 || delta[1] != 0 || delta[2] != 0)
+      kinds.push_back(motion::MakeMove(delta, 3));
+  }
+  std::vector<std::vector<std::uint8_t>> corners;
+  for (int k = 0; k < motion::TurnCaps::kChords; ++k) {
+    const int m = 4 << k;
+    for (const std::uint8_t before : kinds) {
+      for (const std::uint8_t after : kinds) {
+        std::vector<std::uint8_t> moves(static_cast<std::size_t>(m), before);
+        moves.insert(moves.end(), static_cast<std::size_t>(m), after);
+        corners.push_back(moves);
+      }
+    }
+  }
+  return corners;
+}
+
+// A device without turn caps runs no faster than TopSpeedNoChordBinds():
+// measured by the caps themselves, no corner and no random path of 3-D unit
+// moves gets a cap at that speed, for budgets from the smallest to the
+// largest. At √1.53 times that speed (top² = 2.04·budget·2^24), corners
+// bind (the worst one, four moves on one axis then four on three axes, has
+// its cap at top² = 2·budget·2^24): the bound is within √1.5 of the caps'
+// own worst case.
+TEST(TurnCaps, AtTheTopSpeedNoChordBindsNothingIsEverCapped) {
+  const std::vector<std::vector<std::uint8_t>> corners = EveryCorner();
+  std::mt19937_64 rng(17);
+  for (const std::uint32_t budget : {1u, 77u, 2905u, 1u << 20, (1u << 24) - 1}) {
+    const std::uint32_t top = motion::TurnCaps::TopSpeedNoChordBinds(budget);
+    const double exact = std::sqrt(static_cast<double>(budget) * 67108864.0 / 3);
+    EXPECT_LE(top, exact) << budget;
+    EXPECT_GT(top + 1.0, exact) << budget;
+    int binding_faster = 0;
+    for (const std::vector<std::uint8_t>& corner : corners) {
+      EXPECT_FALSE(AnyMoveCapped(budget, top, corner)) << "budget " << budget;
+      if (AnyMoveCapped(budget, static_cast<std::uint32_t>(top * std::sqrt(1.53)), corner)) {
+        ++binding_faster;
+      }
+    }
+    if (budget >= 77) {
+      EXPECT_GT(binding_faster, 0) << "budget " << budget;
+    }
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<std::uint8_t> moves;
+      for (int i = 0; i < 2000; ++i) {
+        const std::int32_t delta[3] = {static_cast<std::int32_t>(rng() % 3) - 1,
+                                       static_cast<std::int32_t>(rng() % 3) - 1,
+                                       static_cast<std::int32_t>(rng() % 3) - 1};
+        if (delta[0] != 0 || delta[1] != 0 || delta[2] != 0)
+          moves.push_back(motion::MakeMove(delta, 3));
+      }
+      EXPECT_FALSE(AnyMoveCapped(budget, top, moves)) << "budget " << budget;
+    }
+  }
+  EXPECT_EQ(motion::TurnCaps::TopSpeedNoChordBinds(0), 1u << motion::kLengthFracBits);
 }
 
 TEST(TurnCaps, ToTickLimitsGivesTheBudgetOfTheSmallestAxis) {

@@ -3,25 +3,6 @@
 
 namespace fdsurf {
 namespace motion {
-namespace {
-
-// ⌊√n⌋ by bisection on the root (n < 2^64; 32 rounds, at configuration).
-uint64_t FloorSqrt(uint64_t n) {
-  uint64_t low = 0;
-  uint64_t high = 1ull << 32;  // high² > n
-  while (high - low > 1) {
-    const uint64_t middle = low + (high - low) / 2;
-    if (middle * middle <= n) {
-      low = middle;
-    } else {
-      high = middle;
-    }
-  }
-  return low;
-}
-
-}  // namespace
-
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
   if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz ||
       limits.travel_rate == 0 || limits.travel_rate > limits.tick_hz) {
@@ -50,6 +31,16 @@ bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
   }
   out->turn_budget =
       smallest == 0 ? 0 : static_cast<uint32_t>(FloorSqrt(smallest * smallest - accel * accel));
+#if !FDSURF_DEVICE_TURN_CAPS
+  // No caps to slow the turns: every speed stays where no chord could bind,
+  // which keeps each axis within its limit on any path (docs/motion.md, "A
+  // device without turn caps"); refused where that leaves no room to
+  // accelerate.
+  const uint32_t no_chord_binds = TurnCaps::TopSpeedNoChordBinds(out->turn_budget);
+  if (out->max_speed > no_chord_binds) out->max_speed = no_chord_binds;
+  if (out->travel_speed > no_chord_binds) out->travel_speed = no_chord_binds;
+  if (out->accel > no_chord_binds) return false;
+#endif
   const uint32_t top = out->max_speed > out->travel_speed ? out->max_speed : out->travel_speed;
   TurnCaps::SkipThresholds(out->turn_budget, top, out->turn_skip);
   return true;

@@ -5,6 +5,39 @@
 
 namespace fdsurf {
 namespace motion {
+
+uint64_t FloorSqrt(uint64_t n) {
+  uint64_t low = 0;
+  uint64_t high = 1ull << 32;  // high² > n
+  while (high - low > 1) {
+    const uint64_t middle = low + (high - low) / 2;
+    if (middle * middle <= n) {
+      low = middle;
+    } else {
+      high = middle;
+    }
+  }
+  return low;
+}
+
+uint32_t TurnCaps::TopSpeedNoChordBinds(uint32_t turn_budget) {
+  if (turn_budget == 0) return uint32_t{1} << kLengthFracBits;
+  // A chord of m moves binds when its doubled turn T exceeds
+  // 2·budget·(h²/2^24)/top², h ≥ m·2^24 (a move is at least a step long).
+  // Per axis the turn is at most 2m, less the rounding allowance r, and
+  // T ≤ 4·(2m − r) over three axes: T/m² is largest for m = 4, r = 2
+  // (24/16), so top² ≤ 2·budget·2^24·16/24 = budget·2^26/3 binds nowhere.
+  // budget ≤ 2^24 (ToTickLimits caps it), so the product is below 2^51.
+  return static_cast<uint32_t>(FloorSqrt((static_cast<uint64_t>(turn_budget) << 26) / 3));
+}
+
+}  // namespace motion
+}  // namespace fdsurf
+
+#if FDSURF_DEVICE_TURN_CAPS
+
+namespace fdsurf {
+namespace motion {
 namespace {
 
 // The step of axis `axis` in a unit move: −1, 0 or +1.
@@ -242,3 +275,5 @@ void TurnCaps::AppendRegion(uint64_t start, uint64_t end, uint64_t braking) {
 
 }  // namespace motion
 }  // namespace fdsurf
+
+#endif  // FDSURF_DEVICE_TURN_CAPS

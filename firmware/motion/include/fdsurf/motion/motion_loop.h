@@ -77,7 +77,10 @@ struct TickLimits {
 /// served: max_rate or travel_rate of 0 or above tick_hz, an acceleration
 /// below 2^-24 steps per tick² (too small to represent at this tick rate) or
 /// above either speed limit per tick, or an axis limit (not 0) that does not
-/// exceed the path's acceleration per tick (AxisLimitServable()).
+/// exceed the path's acceleration per tick (AxisLimitServable()). Built
+/// without turn caps (FDSURF_DEVICE_TURN_CAPS=0), it lowers both speed
+/// limits to TurnCaps::TopSpeedNoChordBinds() of the turn budget, and
+/// returns false when that is below the acceleration.
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out);
 
 /// Whether an axis limit of `axis_accel` steps/s² leaves a turn budget over

@@ -34,8 +34,22 @@
 
 #include "fdsurf/config/nodiscard.h"
 
+// FDSURF_DEVICE_TURN_CAPS=0 builds the class below without caps (a device
+// that must save 6 KB of flash and 400 B of RAM: the Arduino Uno); the
+// device then holds each axis's limit by a lower top speed alone
+// (ToTickLimits(), docs/motion.md "A device without turn caps").
+#ifndef FDSURF_DEVICE_TURN_CAPS
+#define FDSURF_DEVICE_TURN_CAPS 1
+#endif
+
 namespace fdsurf {
 namespace motion {
+
+/// ⌊√n⌋ for any 64-bit n, by bisection on the root (32 rounds: at
+/// configuration only).
+uint64_t FloorSqrt(uint64_t n);
+
+#if FDSURF_DEVICE_TURN_CAPS
 
 class TurnCaps {
  public:
@@ -56,6 +70,13 @@ class TurnCaps {
   /// For each chord, the doubled turn at or below which its cap cannot bind
   /// (divides 64-bit numbers: ToTickLimits() calls it, outside any lock).
   static void SkipThresholds(uint32_t turn_budget, uint32_t top_speed, uint32_t (&skip)[kChords]);
+  /// The largest top speed (2^-24 steps per tick) at which no chord's cap
+  /// can bind on any path of unit moves, for `turn_budget` (as above; 0:
+  /// none, returns 2^24): ⌊√(budget·2^26/3)⌋, from the shortest chord's
+  /// largest turn (docs/motion.md, "A device without turn caps"). Below it
+  /// the caps change nothing, so a device without them keeps each axis
+  /// within its limit by this top speed alone.
+  static uint32_t TopSpeedNoChordBinds(uint32_t turn_budget);
   /// `turn_budget`: the largest centripetal acceleration, 2^-24 steps per
   /// tick² (TickLimits::turn_budget; 0: nothing is capped); `accel` a;
   /// `top_speed` the larger speed limit; `skip` from SkipThresholds().
@@ -181,6 +202,45 @@ class TurnCaps {
   uint8_t first_ = 0;
   uint8_t count_ = 0;
 };
+
+#else
+/// A device built without turn caps (FDSURF_DEVICE_TURN_CAPS=0, the Arduino
+/// Uno's firmware: they are 6 KB of its 32): nothing is measured, every move
+/// is final at once, and no region binds. ToTickLimits() keeps each axis
+/// within its limit instead by a top speed at which no chord could bind
+/// (TopSpeedNoChordBinds()); the same interface, so MotionLoop is unchanged.
+class TurnCaps {
+ public:
+  static constexpr int kChords = 4;
+  static constexpr uint64_t kUnbounded = ~0ull;
+  /// As the capped class's (the same derivation).
+  static uint32_t TopSpeedNoChordBinds(uint32_t turn_budget);
+  static void SkipThresholds(uint32_t /*turn_budget*/, uint32_t /*top_speed*/,
+                             uint32_t (&skip)[kChords]) {
+    for (uint32_t& threshold : skip) threshold = 0;
+  }
+  void Configure(uint32_t /*turn_budget*/, uint32_t /*accel*/, uint32_t /*top_speed*/,
+                 const uint32_t (&/*skip*/)[kChords]) {}
+  void Clear() {}
+  struct Final {
+    uint64_t length;
+    uint64_t braking;
+    bool capped;
+    bool stop;
+  };
+  Final Measure(uint8_t /*move*/, uint32_t length) { return Final{length, 0, false, false}; }
+  Final MeasureAll(bool /*stop*/) { return Final{0, 0, false, false}; }
+  void Commit(const Final& /*final*/) {}
+  FDSURF_NODISCARD bool HasRoom() const { return true; }
+  FDSURF_NODISCARD bool HasPending() const { return false; }
+  struct Bounds {
+    uint64_t braking;
+    uint64_t limit;
+  };
+  /// No bound: the loop's own (the end of the buffer, the next pen event).
+  FDSURF_NODISCARD Bounds At(uint64_t /*position*/) const { return Bounds{kUnbounded, kUnbounded}; }
+};
+#endif  // FDSURF_DEVICE_TURN_CAPS
 
 }  // namespace motion
 }  // namespace fdsurf
