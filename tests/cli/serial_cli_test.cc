@@ -20,6 +20,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -552,6 +553,16 @@ TEST_F(SerialCli, ADeviceOfSixtyFourBitTablesIsSentLongLinesInPieces) {
                             " more commands send the lines it could not hold in pieces"),
             std::string::npos)
       << narrow.err;
+  // The Uno's firmware has no turn caps either: the host says how fast it
+  // will run (the speeds themselves: NoTurnCaps.* in the device tests).
+  const std::regex capped(
+      "has no turn caps: it keeps every axis within its acceleration limit "
+      "on any turn by running at ([0-9]+) steps/s at most \\(the job's "
+      "limits: ([0-9]+) drawing");
+  std::smatch note;
+  ASSERT_TRUE(std::regex_search(narrow.err, note, capped)) << narrow.err;
+  EXPECT_LT(std::stoul(note[1]), std::stoul(note[2]));
+  EXPECT_EQ(full.err.find("turn caps"), std::string::npos) << full.err;
   EXPECT_EQ(pieces["accepted"], pieces["executed"]);
   EXPECT_EQ(pieces["idle"], "1");
   EXPECT_EQ(pieces["pen_down"], "0");

@@ -732,7 +732,8 @@ TEST(CodecValidation, Replies) {
   EXPECT_EQ(hello_with(12, kFeaturePreparedCurves).code, ErrorCode::kNone);
   EXPECT_EQ(hello_with(12, kFeaturePlanner).code, ErrorCode::kNone);
   EXPECT_EQ(hello_with(12, kFeature64BitTables).code, ErrorCode::kNone);
-  EXPECT_EQ(hello_with(12, 0x10).field, kHelloReplyFieldFeatures);  // unknown feature
+  EXPECT_EQ(hello_with(12, kFeatureNoTurnCaps).code, ErrorCode::kNone);
+  EXPECT_EQ(hello_with(12, 0x20).field, kHelloReplyFieldFeatures);  // unknown feature
   const Bytes no_features(good.begin(), good.end() - 1);
   EXPECT_EQ(decode(MessageType::kHelloReply, no_features).field, kHelloReplyFieldFeatures);
   // STATUS_REPORT: state, error code and pen byte ranges.

@@ -6,7 +6,10 @@
 #include <cstdio>
 #include <utility>
 
+#include "fdsurf/device/device.h"
 #include "fdsurf/hal/monotonic_clock.h"
+#include "fdsurf/motion/motion_loop.h"
+#include "fdsurf/motion/turn_caps.h"
 #include "fdsurf/protocol/codec.h"
 
 namespace fdsurf::host {
@@ -327,6 +330,66 @@ std::uint32_t Milliseconds(double seconds) {
   return static_cast<std::uint32_t>(std::ceil(std::clamp(seconds, 0.0, 4.0e6) * 1000.0));
 }
 
+namespace {
+
+// A device ticking slower than the job's speeds: both speed limits lowered
+// to one step per tick, in the CONFIG commands too, with a note.
+void LowerToTickRate(const StreamJob& job, std::uint32_t tick_hz, const std::string& device,
+                     const StreamOptions& o, StreamJob* fitted) {
+  if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return;
+  fitted->config.max_rate = std::min(job.config.max_rate, tick_hz);
+  fitted->config.travel_rate = std::min(job.config.travel_rate, tick_hz);
+  for (protocol::Command& command : fitted->commands) {
+    if (command.type != protocol::MessageType::kConfig) continue;
+    command.body.config.max_rate = fitted->config.max_rate;
+    command.body.config.travel_rate = fitted->config.travel_rate;
+  }
+  if (o.quiet) return;
+  if (job.config.max_rate > tick_hz) {
+    const double lowered = o.speed * tick_hz / job.config.max_rate;
+    std::fprintf(stderr,
+                 "fdsurf: note: %s ticks at %u Hz, one step per tick at most: the speed limit is "
+                 "lowered from %u to %u steps/s (--speed %g %s/s becomes %.4g %s/s)\n",
+                 device.c_str(), tick_hz, job.config.max_rate, tick_hz, o.speed, o.units.c_str(),
+                 lowered, o.units.c_str());
+  }
+  // The pen-up limit is only named when --travel-speed made it differ.
+  if (job.config.travel_rate > tick_hz && job.config.travel_rate != job.config.max_rate) {
+    const double lowered = o.travel_speed * tick_hz / job.config.travel_rate;
+    std::fprintf(stderr,
+                 "fdsurf: note: %s ticks at %u Hz: the pen-up speed limit is lowered from %u to "
+                 "%u steps/s (--travel-speed %g %s/s becomes %.4g %s/s)\n",
+                 device.c_str(), tick_hz, job.config.travel_rate, tick_hz, o.travel_speed,
+                 o.units.c_str(), lowered, o.units.c_str());
+  }
+}
+
+// A device without turn caps (protocol::kFeatureNoTurnCaps) keeps each axis
+// within its limit by a top speed at which no turn could need a cap; the
+// note says what that speed is for this CONFIG, worked out with the
+// firmware's own ToTickLimits() and TurnCaps::TopSpeedNoChordBinds().
+void NoteTopSpeedWithoutTurnCaps(const protocol::MachineConfig& config, std::uint32_t tick_hz,
+                                 const std::string& device) {
+  motion::TickLimits per_tick{};
+  if (!motion::ToTickLimits(device::MotionLimitsOf(config, tick_hz), &per_tick) ||
+      per_tick.turn_budget == 0) {
+    return;
+  }
+  const std::uint64_t top =
+      static_cast<std::uint64_t>(motion::TurnCaps::TopSpeedNoChordBinds(per_tick.turn_budget)) *
+          tick_hz >>
+      motion::kLengthFracBits;
+  if (top >= config.max_rate && top >= config.travel_rate) return;
+  std::fprintf(stderr,
+               "fdsurf: note: %s has no turn caps: it keeps every axis within its acceleration "
+               "limit on any turn by running at %llu steps/s at most (the job's limits: %u "
+               "drawing, %u travelling; a higher --axis-accel raises it)\n",
+               device.c_str(), static_cast<unsigned long long>(top), config.max_rate,
+               config.travel_rate);
+}
+
+}  // namespace
+
 StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello,
                          const std::string& device, const StreamOptions& o) {
   if (hello.max_axes < job.config.axes) {
@@ -354,32 +417,9 @@ StreamJob FitJobToDevice(const StreamJob& job, const protocol::HelloReply& hello
                    device.c_str(), more);
     }
   }
-  const std::uint32_t tick_hz = hello.tick_hz;
-  if (job.config.max_rate <= tick_hz && job.config.travel_rate <= tick_hz) return fitted;
-  fitted.config.max_rate = std::min(job.config.max_rate, tick_hz);
-  fitted.config.travel_rate = std::min(job.config.travel_rate, tick_hz);
-  for (protocol::Command& command : fitted.commands) {
-    if (command.type != protocol::MessageType::kConfig) continue;
-    command.body.config.max_rate = fitted.config.max_rate;
-    command.body.config.travel_rate = fitted.config.travel_rate;
-  }
-  if (o.quiet) return fitted;
-  if (job.config.max_rate > tick_hz) {
-    const double lowered = o.speed * tick_hz / job.config.max_rate;
-    std::fprintf(stderr,
-                 "fdsurf: note: %s ticks at %u Hz, one step per tick at most: the speed limit is "
-                 "lowered from %u to %u steps/s (--speed %g %s/s becomes %.4g %s/s)\n",
-                 device.c_str(), tick_hz, job.config.max_rate, tick_hz, o.speed, o.units.c_str(),
-                 lowered, o.units.c_str());
-  }
-  // The pen-up limit is only named when --travel-speed made it differ.
-  if (job.config.travel_rate > tick_hz && job.config.travel_rate != job.config.max_rate) {
-    const double lowered = o.travel_speed * tick_hz / job.config.travel_rate;
-    std::fprintf(stderr,
-                 "fdsurf: note: %s ticks at %u Hz: the pen-up speed limit is lowered from %u to "
-                 "%u steps/s (--travel-speed %g %s/s becomes %.4g %s/s)\n",
-                 device.c_str(), tick_hz, job.config.travel_rate, tick_hz, o.travel_speed,
-                 o.units.c_str(), lowered, o.units.c_str());
+  LowerToTickRate(job, hello.tick_hz, device, o, &fitted);
+  if ((hello.features & protocol::kFeatureNoTurnCaps) != 0 && !o.quiet) {
+    NoteTopSpeedWithoutTurnCaps(fitted.config, hello.tick_hz, device);
   }
   return fitted;
 }

@@ -75,6 +75,19 @@ struct SingleThreadLock {
   SingleThreadLock() {}  // NOLINT(modernize-use-equals-default)
 };
 
+/// A CONFIG's limits as the motion loop takes them at `tick_hz` (the axis
+/// limits of the axes it configures; the others 0). The host works out what
+/// a device will do with its CONFIG by the same conversion.
+inline motion::MotionLimits MotionLimitsOf(const protocol::MachineConfig& config,
+                                           uint32_t tick_hz) {
+  motion::MotionLimits limits{
+      tick_hz, config.max_rate, config.accel, config.pen_delay_ms, config.travel_rate, {0, 0, 0}};
+  for (int a = 0; a < config.axes && a < protocol::kMaxAxes && a < 3; ++a) {
+    limits.axis_accel[a] = config.axis_accel[a];
+  }
+  return limits;
+}
+
 /// kAxes: 2 (a pen plotter) or 3 (a CNC with Z). kQueueCapacity: commands
 /// that can wait (the host's credit). kLookahead: unit moves and events
 /// buffered ahead of the motion, a power of two; the loop reaches full speed
@@ -313,7 +326,9 @@ class Device {
     const uint8_t endstops = endstops_ != nullptr ? protocol::kFeatureEndstops : 0;
     const uint8_t planner = FDSURF_DEVICE_PLANNER ? protocol::kFeaturePlanner : 0;
     const uint8_t narrow = FDSURF_DEVICE_WIDE_TABLES ? 0 : protocol::kFeature64BitTables;
-    return static_cast<uint8_t>(endstops | planner | narrow | protocol::kFeaturePreparedCurves);
+    const uint8_t uncapped = FDSURF_DEVICE_TURN_CAPS ? 0 : protocol::kFeatureNoTurnCaps;
+    return static_cast<uint8_t>(endstops | planner | narrow | uncapped |
+                                protocol::kFeaturePreparedCurves);
   }
 
   void FillStatus(protocol::StatusReport* report) const {
@@ -423,13 +438,7 @@ class Device {
 
  private:
   FDSURF_NODISCARD motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
-    motion::MotionLimits limits{tick_hz_,           config.max_rate,
-                                config.accel,       config.pen_delay_ms,
-                                config.travel_rate, {0, 0, 0}};
-    for (int a = 0; a < config.axes && a < protocol::kMaxAxes && a < 3; ++a) {
-      limits.axis_accel[a] = config.axis_accel[a];
-    }
-    return limits;
+    return MotionLimitsOf(config, tick_hz_);
   }
 
   // Each used axis's acceleration limit must exceed the path's at this tick

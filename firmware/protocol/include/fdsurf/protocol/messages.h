@@ -329,9 +329,15 @@ constexpr uint8_t kFeaturePlanner = 0x04;
 /// 128-bit accumulator, so the host sends such a line in pieces
 /// (host::SplitForSixtyFourBitTables).
 constexpr uint8_t kFeature64BitTables = 0x08;
+/// HelloReply::features: the device has no turn caps
+/// (FDSURF_DEVICE_TURN_CAPS=0, motion/turn_caps.h): with axis limits in its
+/// CONFIG it keeps each axis within them by a lower top speed, where no
+/// turn could need a cap, instead of slowing on the turns alone (the host
+/// says so).
+constexpr uint8_t kFeatureNoTurnCaps = 0x10;
 /// Every feature bit this version knows; a HELLO_REPLY with another is refused.
-constexpr uint8_t kKnownFeatures =
-    kFeatureEndstops | kFeaturePreparedCurves | kFeaturePlanner | kFeature64BitTables;
+constexpr uint8_t kKnownFeatures = kFeatureEndstops | kFeaturePreparedCurves | kFeaturePlanner |
+                                   kFeature64BitTables | kFeatureNoTurnCaps;
 
 struct StatusReport {
   DeviceState state;
