@@ -82,8 +82,11 @@ class PortOutputs final : public hal::StepDirOutputs, public hal::PenOutput {
 #ifndef FDSURF_SIZE_DEVICE_LOOKAHEAD
 #define FDSURF_SIZE_DEVICE_LOOKAHEAD 256
 #endif
+#ifndef FDSURF_SIZE_DEVICE_REPLY_BYTES
+#define FDSURF_SIZE_DEVICE_REPLY_BYTES 256
+#endif
 device::Device<2, FDSURF_SIZE_DEVICE_QUEUE, FDSURF_SIZE_DEVICE_LOOKAHEAD, device::SingleThreadLock,
-               FDSURF_SIZE_DEVICE_FRAME_BYTES>
+               FDSURF_SIZE_DEVICE_FRAME_BYTES, FDSURF_SIZE_DEVICE_REPLY_BYTES>
     g_device(40000);
 UartTransport g_transport;
 PortOutputs g_outputs;

@@ -95,9 +95,13 @@ inline motion::MotionLimits MotionLimitsOf(const protocol::MachineConfig& config
 /// InterruptLock: see the top of this file. kFrameBytes: the largest decoded
 /// frame taken, protocol::kMaxFrameBytes, or protocol::kMaxPreparedFrameBytes
 /// on a device built without the planner (FDSURF_DEVICE_PLANNER=0) that
-/// must save RAM.
+/// must save RAM. kReplyBytes: encoded replies held until Service() hands
+/// them to the transport, at least the largest (41 bytes); a reply that
+/// finds no room is dropped and the host's retransmission brings it again,
+/// so a small chip (the Uno: 96) trades only a rare resend for the RAM.
 template <int kAxes, int kQueueCapacity = 8, int kLookahead = 1024,
-          class InterruptLock = SingleThreadLock, size_t kFrameBytes = protocol::kMaxFrameBytes>
+          class InterruptLock = SingleThreadLock, size_t kFrameBytes = protocol::kMaxFrameBytes,
+          size_t kReplyBytes = 256>
 class Device {
  public:
   static_assert(kAxes == 2 || kAxes == 3, "2 or 3 axes");
@@ -900,7 +904,7 @@ class Device {
   enum class PausePhase : uint8_t { kNone, kBraking, kLifting, kHeld, kLowering };
 
   uint32_t tick_hz_;
-  protocol::DeviceLink<Device, 256, kFrameBytes> link_;
+  protocol::DeviceLink<Device, kReplyBytes, kFrameBytes> link_;
   uint8_t lookahead_[kLookahead];
   motion::MotionLoop motion_;
   motion::PathGenerator<kAxes> generator_;
