@@ -14,31 +14,8 @@
 namespace fdsurf::board {
 namespace {
 
-// ATmega2560 interrupt vectors (avr-libc's iom2560.h) and registers (data
-// space addresses).
-constexpr std::uint8_t kTickVector = 32;  // TIMER3_COMPA
-constexpr std::uint8_t kRxVector = 25;    // USART0_RX
-constexpr std::uint16_t kTccr3b = 0x91;
-constexpr std::uint16_t kOcr3a = 0x98;
-constexpr std::uint16_t kRamEnd = 0x21FF;
-constexpr std::uint16_t kRamStart = 0x200;
 constexpr std::uint8_t kStackPaint = 0xA5;
-constexpr std::uint16_t kGpior0 = 0x3E;
 constexpr std::uint8_t kWatchdogResetFlag = 0x08;  // MCUSR.WDRF
-
-// The RAMPS 1.4 lines (boards/mega2560-ramps/src/ramps_outputs.h).
-const Recorder::Signal kRampsSignals[Recorder::kSignals] = {
-    {"X_STEP", 'F', 0, 0x30, 0x31, true, nullptr, false, 0},
-    {"X_DIR", 'F', 1, 0x30, 0x31, false, nullptr, false, 0},
-    {"X_EN", 'D', 7, 0x2A, 0x2B, false, nullptr, false, 0},
-    {"Y_STEP", 'F', 6, 0x30, 0x31, true, nullptr, false, 0},
-    {"Y_DIR", 'F', 7, 0x30, 0x31, false, nullptr, false, 0},
-    {"Y_EN", 'F', 2, 0x30, 0x31, false, nullptr, false, 0},
-    {"Z_STEP", 'L', 3, 0x10A, 0x10B, true, nullptr, false, 0},
-    {"Z_DIR", 'L', 1, 0x10A, 0x10B, false, nullptr, false, 0},
-    {"Z_EN", 'K', 0, 0x107, 0x108, false, nullptr, false, 0},
-    {"SERVO", 'B', 5, 0x24, 0x25, false, nullptr, false, 0},
-};
 
 Recorder* g_recorder = nullptr;  // for simavr's sleep hook
 
@@ -65,11 +42,12 @@ bool Recorder::Open(const std::string& path, std::string* error) {
     return false;
   }
   path_ = path;
-  // The pen: the image's default servo pulses (board_config.h).
-  std::fputs(
-      "# fdsurf-waveform 1\n# board mega2560-ramps\n# dir_negative_level 1\n"
-      "# enable_active_level 0\n# pen servo 1000 2000\n",
-      file_);
+  // The pen: the image's default servo pulses (its board_config.h).
+  std::fprintf(file_,
+               "# fdsurf-waveform 1\n# board %s\n# dir_negative_level 1\n"
+               "# enable_active_level 0\n# pen servo %u %u\n",
+               board_.name, static_cast<unsigned>(board_.servo_up_us),
+               static_cast<unsigned>(board_.servo_down_us));
   return true;
 }
 
@@ -77,24 +55,24 @@ void Recorder::Attach(avr_t* avr) {
   avr_ = avr;
   g_recorder = this;
   for (int i = 0; i < kSignals; ++i) {
-    signals_[i] = kRampsSignals[i];
-    signals_[i].recorder = this;
+    signals_[i] = Signal{board_.signals[i], this, false, 0};
     Signal* s = &signals_[i];
+    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(s->line.pin.port),
+                                          IOPORT_IRQ_PIN0 + s->line.pin.bit),
+                            OnPin, s);
     avr_irq_register_notify(
-        avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(s->port), IOPORT_IRQ_PIN0 + s->bit), OnPin, s);
-    avr_irq_register_notify(
-        avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(s->port), IOPORT_IRQ_DIRECTION_ALL), OnDirection,
-        s);
+        avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(s->line.pin.port), IOPORT_IRQ_DIRECTION_ALL),
+        OnDirection, s);
   }
-  avr_irq_t* tick = avr_get_interrupt_irq(avr, kTickVector);
+  avr_irq_t* tick = avr_get_interrupt_irq(avr, board_.tick_vector);
   avr_irq_register_notify(tick + AVR_INT_IRQ_PENDING, OnTickPending, this);
   avr_irq_register_notify(tick + AVR_INT_IRQ_RUNNING, OnTickRunning, this);
-  avr_irq_register_notify(avr_get_interrupt_irq(avr, kRxVector) + AVR_INT_IRQ_RUNNING, OnRxRunning,
-                          this);
+  avr_irq_register_notify(avr_get_interrupt_irq(avr, board_.rx_vector) + AVR_INT_IRQ_RUNNING,
+                          OnRxRunning, this);
   avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT), OnUartIn,
                           this);
   avr->sleep = OnSleep;
-  avr_register_io_write(avr, kGpior0, OnBoot, this);
+  avr_register_io_write(avr, board_.gpior0, OnBoot, this);
 }
 
 // The firmware's first instructions copy MCUSR (why it reset) to GPIOR0.
@@ -113,7 +91,7 @@ void Recorder::Write(const Signal& signal) {
   if (file_ == nullptr) return;
   // 16 MHz: 62.5 ns a cycle.
   std::fprintf(file_, "%llu %s %d\n", static_cast<unsigned long long>(avr_->cycle * 125 / 2),
-               signal.name, signal.level);
+               signal.line.name, signal.level);
 }
 
 void Recorder::OnPin(avr_irq_t*, std::uint32_t value, void* param) {
@@ -123,24 +101,24 @@ void Recorder::OnPin(avr_irq_t*, std::uint32_t value, void* param) {
   s->level = level;
   Recorder* r = s->recorder;
   r->Write(*s);
-  if (s->step && level == 1 && r->in_tick_) r->stepped_ = true;
+  if (s->line.step && level == 1 && r->in_tick_) r->stepped_ = true;
 }
 
 // A line enters the waveform when the firmware makes it an output, with the
 // level its PORT bit drives.
 void Recorder::OnDirection(avr_irq_t*, std::uint32_t value, void* param) {
   auto* s = static_cast<Signal*>(param);
-  if (s->started || (value & (1u << s->bit)) == 0) return;
+  if (s->started || (value & (1u << s->line.pin.bit)) == 0) return;
   s->started = true;
-  s->level = (s->recorder->avr_->data[s->out] >> s->bit) & 1;
+  s->level = (s->recorder->avr_->data[s->line.pin.out] >> s->line.pin.bit) & 1;
   s->recorder->Write(*s);
 }
 
 std::uint64_t Recorder::TickPeriod() const {
   static const std::uint16_t kPrescale[8] = {0, 1, 8, 64, 256, 1024, 0, 0};
-  const std::uint16_t prescale = kPrescale[avr_->data[kTccr3b] & 7u];
-  const std::uint16_t top =
-      static_cast<std::uint16_t>(avr_->data[kOcr3a] | (avr_->data[kOcr3a + 1] << 8));
+  const std::uint16_t prescale = kPrescale[avr_->data[board_.tick_tccrb] & 7u];
+  const std::uint16_t top = static_cast<std::uint16_t>(avr_->data[board_.tick_ocra] |
+                                                       (avr_->data[board_.tick_ocra + 1] << 8));
   return static_cast<std::uint64_t>(top + 1u) * prescale;
 }
 
@@ -214,18 +192,19 @@ void Recorder::Finish(avr_t*) {
 }
 
 std::uint32_t Recorder::StackHighWater(avr_t* avr, const ImageFacts& facts) const {
-  const std::uint16_t heap_start = static_cast<std::uint16_t>(kRamStart + facts.data + facts.bss);
+  const std::uint16_t heap_start =
+      static_cast<std::uint16_t>(board_.ram_start + facts.data + facts.bss);
   std::uint16_t p = heap_start;
-  while (p <= kRamEnd && avr->data[p] == kStackPaint) ++p;
-  return static_cast<std::uint32_t>(kRamEnd - p + 1);
+  while (p <= board_.ram_end && avr->data[p] == kStackPaint) ++p;
+  return static_cast<std::uint32_t>(board_.ram_end - p + 1);
 }
 
 namespace {
 
-// The UART0 bit rate the firmware set (UBRR0, U2X0), 10 bits a byte (8N1).
-double UartBytesPerSecond(const avr_t* avr) {
-  const unsigned ubrr = avr->data[0xC4] | ((avr->data[0xC5] & 0x0Fu) << 8);
-  const bool u2x = (avr->data[0xC0] & 0x02u) != 0;
+// The USART's bit rate the firmware set (UBRRn, U2Xn), 10 bits a byte (8N1).
+double UartBytesPerSecond(const avr_t* avr, const AvrBoard& board) {
+  const unsigned ubrr = avr->data[board.ubrr] | ((avr->data[board.ubrr + 1] & 0x0Fu) << 8);
+  const bool u2x = (avr->data[board.ucsra] & 0x02u) != 0;
   return 16e6 / ((u2x ? 8.0 : 16.0) * (ubrr + 1)) / 10.0;
 }
 
@@ -258,7 +237,8 @@ bool Recorder::WriteMeasures(const std::string& path, avr_t* avr, const ImageFac
   Row(f, "flash", facts.flash, "bytes");
   Row(f, "static_ram", facts.data + facts.bss, "bytes");
   Row(f, "stack_high_water", stack, "bytes");
-  Row(f, "ram_never_used", 8192.0 - facts.data - facts.bss - stack, "bytes");
+  Row(f, "ram_never_used", static_cast<double>(board_.RamBytes()) - facts.data - facts.bss - stack,
+      "bytes");
   Row(f, "tick_hz", period == 0 ? 0.0 : 16e6 / static_cast<double>(period), "Hz");
   Row(f, "tick_period", static_cast<double>(period), "cycles");
   Stats(f, "tick_isr", tick_);
@@ -283,7 +263,7 @@ bool Recorder::WriteMeasures(const std::string& path, avr_t* avr, const ImageFac
       "fraction");
   Row(f, "link_bytes_in_per_s_drawing",
       window > 0 ? static_cast<double>(b.bytes_in - a.bytes_in) / (window / 16e6) : 0.0, "bytes/s");
-  Row(f, "uart_capacity", UartBytesPerSecond(avr), "bytes/s each way");
+  Row(f, "uart_capacity", UartBytesPerSecond(avr, board_), "bytes/s each way");
   Row(f, "uart_bytes_in", static_cast<double>(bridge_in), "bytes");
   Row(f, "uart_bytes_out", static_cast<double>(bridge_out), "bytes");
   Row(f, "boots", static_cast<double>(boots_), "starts");

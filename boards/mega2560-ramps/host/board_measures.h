@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
-// What fdsurf_simavr_board records from the emulated Mega: the RAMPS pins
-// as a waveform (format 1, docs/boards.md), and the measures of the
-// firmware's timing and memory (host/README.md):
+// What fdsurf_simavr_board records from an emulated AVR board (avr_boards.h:
+// the Mega 2560 + RAMPS, the Uno + CNC Shield): its step/dir/enable and
+// servo pins as a waveform (format 1, docs/boards.md), and the measures of
+// the firmware's timing and memory (../README.md):
 //
-//   - the step interrupt (Timer3 compare A) from its vector to its RETI, in
+//   - the step interrupt (the step timer's compare A) from its vector to its RETI, in
 //     cycles: min, mean, max, over all ticks and over the ticks that step;
 //   - late ticks: an interrupt that starts a period or more after its
 //     compare match, and compare matches lost while the flag was still set;
@@ -20,6 +21,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+
+#include "avr_boards.h"
 
 namespace fdsurf::board {
 
@@ -54,7 +57,7 @@ struct Accumulated {
 
 class Recorder {
  public:
-  Recorder() = default;
+  explicit Recorder(const AvrBoard& board) : board_(board) {}
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
   ~Recorder();
@@ -73,17 +76,12 @@ class Recorder {
 
   /// One recorded pin.
   struct Signal {
-    const char* name;
-    char port;  // 'B', 'D', 'F', 'K', 'L'
-    std::uint8_t bit;
-    std::uint16_t ddr;  // data-space addresses of its DDR and PORT
-    std::uint16_t out;
-    bool step;  // a STEP line (counts the tick as a point)
+    AvrSignal line;
     Recorder* recorder;
     bool started;  // set up as an output: its changes are recorded
     int level;
   };
-  static constexpr int kSignals = 10;
+  static constexpr int kSignals = AvrBoard::kSignals;
 
  private:
   static void OnPin(avr_irq_t* irq, std::uint32_t value, void* param);
@@ -98,6 +96,7 @@ class Recorder {
   [[nodiscard]] std::uint64_t TickPeriod() const;
   [[nodiscard]] std::uint32_t StackHighWater(avr_t* avr, const ImageFacts& facts) const;
 
+  const AvrBoard& board_;
   avr_t* avr_ = nullptr;
   std::FILE* file_ = nullptr;
   std::string path_;

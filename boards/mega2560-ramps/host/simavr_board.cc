@@ -1,28 +1,33 @@
 // SPDX-License-Identifier: MIT
-// fdsurf_simavr_board: the Mega 2560 + RAMPS 1.4 image under simavr, as the
-// emulator harness of boards/README (docs/boards.md) describes:
+// fdsurf_simavr_board: an AVR board's image under simavr, as the emulator
+// harness of boards/README (docs/boards.md) describes. The boards
+// (avr_boards.h): mega2560-ramps (the default) and uno-cnc-shield.
 //
 //   fdsurf_simavr_board --elf IMAGE.elf --uart-socket PATH --waveform OUT
+//                       [--board mega2560-ramps|uno-cnc-shield]
 //                       [--time-limit-s N] [--measures OUT.tsv] [--speed realtime|max]
 //                       [--endstop-start X,Y[,Z]] [--endstop-triggered-level 1|0]
 //
-// UART0 is bridged to a Unix-domain stream socket at PATH (one client at a
+// USART0 is bridged to a Unix-domain stream socket at PATH (one client at a
 // time; the next is accepted when it leaves). Received bytes enter simavr's
 // UART at its byte timing under its XON/XOFF input flow control, so none is
-// lost by the emulator. Every change of the RAMPS step/dir/enable pins and
-// of the servo pin (D11 = PB5 = OC1A) goes to OUT with its emulated time in
-// ns (waveform format 1). With --measures: the step interrupt's cycles, late
-// ticks, the main loop's cycles per emitted point, the painted stack's
-// high-water mark, flash and static RAM, as a TSV (host/README.md).
+// lost by the emulator. Every change of the board's step/dir/enable pins and
+// of its servo pin (the Mega's D11 = PB5 = OC1A, the Uno's D11 = PB3 = OC2A)
+// goes to OUT with its emulated time in ns (waveform format 1). With
+// --measures: the step interrupt's cycles, late ticks, the main loop's
+// cycles per emitted point, the painted stack's high-water mark, flash and
+// static RAM, as a TSV (../README.md).
 // With --endstop-start: a simulated carriage on each axis, starting the
-// given number of steps above its min switch (below 0: past it) (X_MIN D3 = PE5, Y_MIN D14 =
-// PJ1, Z_MIN D18 = PD3); every STEP pulse moves it one step (DIR high:
+// given number of steps above its min switch (below 0: past it) (the Mega:
+// X_MIN D3 = PE5, Y_MIN D14 = PJ1, Z_MIN D18 = PD3; the Uno: X D9 = PB1,
+// Y D10 = PB2, Z D12 = PB4); every STEP pulse moves it one step (DIR high:
 // towards the switch), and the switch's input pin is driven to the
-// triggered level (default 1, the image's default for normally-closed
+// triggered level (default 1, the images' default for normally-closed
 // switches) at and below position 0, to the other level above it. Without
-// it, every min input is held at its released level. The max inputs (X_MAX
-// D2 = PE4, Y_MAX D15 = PJ0, Z_MAX D19 = PD2) are always held released. Each switch change and
-// the carriage's final position go to stderr ("carriage ...").
+// it, every min input is held at its released level. The Mega's max inputs
+// (X_MAX D2 = PE4, Y_MAX D15 = PJ0, Z_MAX D19 = PD2) are always held
+// released (the Uno has none). Each switch change and the carriage's final
+// position go to stderr ("carriage ...").
 // Exits 0 on SIGTERM/SIGINT or at the time limit, having flushed OUT.
 #include <avr_ioport.h>
 #include <avr_uart.h>
@@ -48,6 +53,7 @@
 #include <string>
 #include <vector>
 
+#include "avr_boards.h"
 #include "board_measures.h"
 
 namespace {
@@ -61,6 +67,7 @@ volatile std::sig_atomic_t g_stop = 0;
 void OnSignal(int) { g_stop = 1; }
 
 struct Options {
+  const fdsurf::board::AvrBoard* board = fdsurf::board::FindAvrBoard("mega2560-ramps");
   std::string elf;
   std::string socket_path;
   std::string waveform;
@@ -74,7 +81,8 @@ struct Options {
 [[noreturn]] void Usage(const std::string& why) {
   std::fprintf(stderr,
                "fdsurf_simavr_board: %s\nusage: fdsurf_simavr_board --elf IMAGE.elf "
-               "--uart-socket PATH --waveform OUT [--time-limit-s N] [--measures OUT.tsv] "
+               "--uart-socket PATH --waveform OUT [--board NAME] [--time-limit-s N] "
+               "[--measures OUT.tsv] "
                "[--speed realtime|max] [--endstop-start X,Y[,Z]] "
                "[--endstop-triggered-level 1|0]\n",
                why.c_str());
@@ -109,6 +117,11 @@ Options ParseOptions(int argc, char** argv) {
     const std::string value = argv[++i];
     if (arg == "--elf") {
       o.elf = value;
+    } else if (arg == "--board") {
+      o.board = fdsurf::board::FindAvrBoard(value);
+      if (o.board == nullptr) {
+        Usage("--board: '" + value + "' is not one of " + fdsurf::board::AvrBoardNames());
+      }
     } else if (arg == "--uart-socket") {
       o.socket_path = value;
     } else if (arg == "--waveform") {
@@ -280,7 +293,8 @@ class Carriage {
  public:
   /// Drives every min input to its level; with `start` empty the switches
   /// stay released and nothing moves.
-  void Attach(avr_t* avr, const std::vector<long>& start, int triggered_level);
+  void Attach(avr_t* avr, const fdsurf::board::AvrBoard& board, const std::vector<long>& start,
+              int triggered_level);
   /// Drives the inputs again (the firmware's own PORT writes cannot have
   /// changed what the switch says for longer than a slice).
   void Reassert();
@@ -288,12 +302,10 @@ class Carriage {
 
  private:
   struct Axis {
-    char name;
-    char step_port, dir_port, min_port;
-    std::uint8_t step_bit, dir_bit, min_bit, max_bit;  // the max switch on min_port too
+    fdsurf::board::AvrAxis pins;
     avr_irq_t* dir = nullptr;
     avr_irq_t* min = nullptr;
-    avr_irq_t* max = nullptr;  // always released
+    avr_irq_t* max = nullptr;  // always released; nullptr: the board has none
     long position = 0;
     bool modelled = false;
     bool triggered = false;
@@ -305,30 +317,27 @@ class Carriage {
 
   avr_t* avr_ = nullptr;
   int triggered_level_ = 1;
-  // The RAMPS pins (ramps_outputs.h, ramps_inputs.h).
-  Axis axes_[3] = {
-      {'X', 'F', 'F', 'E', 0, 1, 5}, {'Y', 'F', 'F', 'J', 6, 7, 1}, {'Z', 'L', 'L', 'D', 3, 1, 3}};
+  Axis axes_[3];
 };
 
-void Carriage::Attach(avr_t* avr, const std::vector<long>& start, int triggered_level) {
+avr_irq_t* PinIrq(avr_t* avr, const fdsurf::board::AvrPin& pin) {
+  return avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(pin.port), IOPORT_IRQ_PIN0 + pin.bit);
+}
+
+void Carriage::Attach(avr_t* avr, const fdsurf::board::AvrBoard& board,
+                      const std::vector<long>& start, int triggered_level) {
   avr_ = avr;
   triggered_level_ = triggered_level;
   for (std::size_t a = 0; a < 3; ++a) {
     Axis* axis = &axes_[a];
+    axis->pins = board.axes[a];
     axis->carriage = this;
     axis->modelled = a < start.size();
     axis->position = axis->modelled ? start[a] : 1;
-    axis->dir = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->dir_port),
-                              IOPORT_IRQ_PIN0 + axis->dir_bit);
-    axis->min = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
-                              IOPORT_IRQ_PIN0 + axis->min_bit);
-    axis->max = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->min_port),
-                              IOPORT_IRQ_PIN0 + axis->max_bit);
-    if (axis->modelled) {
-      avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(axis->step_port),
-                                            IOPORT_IRQ_PIN0 + axis->step_bit),
-                              OnStep, axis);
-    }
+    axis->dir = PinIrq(avr, axis->pins.dir);
+    axis->min = PinIrq(avr, axis->pins.min);
+    axis->max = axis->pins.has_max ? PinIrq(avr, axis->pins.max) : nullptr;
+    if (axis->modelled) avr_irq_register_notify(PinIrq(avr, axis->pins.step), OnStep, axis);
     Drive(axis);
   }
 }
@@ -348,12 +357,12 @@ void Carriage::Drive(Axis* axis) {
   const bool triggered = axis->modelled && axis->position <= 0;
   if (triggered != axis->triggered) {
     std::fprintf(stderr, "fdsurf_simavr_board: %c min switch %s at position %ld, %.6f s\n",
-                 axis->name, triggered ? "triggered" : "released", axis->position,
+                 axis->pins.name, triggered ? "triggered" : "released", axis->position,
                  static_cast<double>(avr_->cycle) / kCpuHz);
   }
   axis->triggered = triggered;
   avr_raise_irq(axis->min, triggered ? triggered_level_ : 1 - triggered_level_);
-  avr_raise_irq(axis->max, 1 - triggered_level_);
+  if (axis->max != nullptr) avr_raise_irq(axis->max, 1 - triggered_level_);
 }
 
 void Carriage::Reassert() {
@@ -361,14 +370,14 @@ void Carriage::Reassert() {
     const std::uint32_t level = axis.triggered ? triggered_level_ : 1 - triggered_level_;
     if (axis.min->value != level) avr_raise_irq(axis.min, level);
     const std::uint32_t released = 1 - triggered_level_;
-    if (axis.max->value != released) avr_raise_irq(axis.max, released);
+    if (axis.max != nullptr && axis.max->value != released) avr_raise_irq(axis.max, released);
   }
 }
 
 void Carriage::Report() const {
   std::fprintf(stderr, "fdsurf_simavr_board: carriage");
   for (const Axis& axis : axes_) {
-    if (axis.modelled) std::fprintf(stderr, " %c %ld", axis.name, axis.position);
+    if (axis.modelled) std::fprintf(stderr, " %c %ld", axis.pins.name, axis.position);
   }
   std::fprintf(stderr, "\n");
 }
@@ -380,12 +389,12 @@ struct Emulator {
   elf_firmware_t firmware{};
 };
 
-bool LoadImage(const std::string& path, Emulator* emulator) {
+bool LoadImage(const std::string& path, const char* mcu, Emulator* emulator) {
   if (elf_read_firmware(path.c_str(), &emulator->firmware) != 0) {
     std::fprintf(stderr, "fdsurf_simavr_board: %s: cannot read the ELF image\n", path.c_str());
     return false;
   }
-  emulator->avr = avr_make_mcu_by_name("atmega2560");
+  emulator->avr = avr_make_mcu_by_name(mcu);
   if (emulator->avr == nullptr) return false;
   avr_init(emulator->avr);
   emulator->avr->log = LOG_ERROR;
@@ -441,8 +450,8 @@ int main(int argc, char** argv) {
   FILE* out = fdopen(dup(STDOUT_FILENO), "w");
   if (out == nullptr || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) return 2;
   Emulator emulator;
-  if (!LoadImage(o.elf, &emulator)) return 2;
-  fdsurf::board::Recorder recorder;
+  if (!LoadImage(o.elf, o.board->mcu, &emulator)) return 2;
+  fdsurf::board::Recorder recorder(*o.board);
   std::string error;
   if (!recorder.Open(o.waveform, &error)) {
     std::fprintf(stderr, "fdsurf_simavr_board: %s\n", error.c_str());
@@ -452,7 +461,7 @@ int main(int argc, char** argv) {
   UartBridge bridge;
   bridge.Attach(emulator.avr);
   Carriage carriage;
-  carriage.Attach(emulator.avr, o.endstop_start, o.triggered_level);
+  carriage.Attach(emulator.avr, *o.board, o.endstop_start, o.triggered_level);
   if (!bridge.Listen(o.socket_path, &error)) {
     std::fprintf(stderr, "fdsurf_simavr_board: --uart-socket %s\n", error.c_str());
     return 2;

@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+// The AVR boards fdsurf_simavr_board runs (--board): for each one, the
+// simavr part, the registers and vectors its measures read, the pins its
+// waveform records and the pins of its simulated carriage. The pins are the
+// firmware's (boards/<board>/src/); the register addresses and vector
+// numbers are the data-space ones of avr-libc's io headers (iom2560.h,
+// iom328p.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace fdsurf::board {
+
+/// A port bit, with the data-space addresses of its DDR and PORT registers.
+struct AvrPin {
+  char port;  // 'B', 'D', ...
+  std::uint8_t bit;
+  std::uint16_t ddr;
+  std::uint16_t out;
+};
+
+/// One line of the waveform (format 1, docs/boards.md).
+struct AvrSignal {
+  const char* name;  // X_STEP ... SERVO
+  AvrPin pin;
+  bool step;  // a STEP line (a tick that raises it emitted a point)
+};
+
+/// One axis of the simulated carriage: its STEP and DIR outputs and its min
+/// (and max, if the board has one) switch inputs.
+struct AvrAxis {
+  char name;
+  AvrPin step;
+  AvrPin dir;
+  AvrPin min;
+  bool has_max;
+  AvrPin max;  // held released; unused without has_max
+};
+
+struct AvrBoard {
+  static constexpr int kSignals = 10;
+
+  const char* name;  // --board, and the waveform's "# board"
+  const char* mcu;   // simavr's part name
+  // The step timer's compare A and the USART's receive vectors.
+  std::uint8_t tick_vector;
+  std::uint8_t rx_vector;
+  // Data-space addresses: the step timer's TCCRnB and OCRnA (16 bits, low
+  // byte first), the USART's UCSRnA and UBRRn (low byte first), GPIOR0 (the
+  // firmware's first instructions copy MCUSR there).
+  std::uint16_t tick_tccrb;
+  std::uint16_t tick_ocra;
+  std::uint16_t ucsra;
+  std::uint16_t ubrr;
+  std::uint16_t gpior0;
+  // The internal RAM, first and last byte (data space).
+  std::uint16_t ram_start;
+  std::uint16_t ram_end;
+  // The image's default servo widths (the waveform header's "# pen servo").
+  std::uint16_t servo_up_us;
+  std::uint16_t servo_down_us;
+  AvrSignal signals[kSignals];
+  AvrAxis axes[3];
+
+  [[nodiscard]] std::uint32_t RamBytes() const {
+    return static_cast<std::uint32_t>(ram_end - ram_start + 1u);
+  }
+};
+
+/// The board named `name` (mega2560-ramps, uno-cnc-shield), or nullptr.
+const AvrBoard* FindAvrBoard(const std::string& name);
+/// The names FindAvrBoard knows, "a, b".
+std::string AvrBoardNames();
+
+}  // namespace fdsurf::board
