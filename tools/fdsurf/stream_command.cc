@@ -253,6 +253,9 @@ void AddSimulatorOptions(CLI::App* command, StreamOptions* o) {
                    "sim: charge the device's validation time as on this MCU (none, atmega2560)")
       ->check(CLI::IsMember({"none", "atmega2560"}))
       ->capture_default_str();
+  command->add_flag("--sim-64bit-tables", o->sim_64bit_tables,
+                    "sim: send the job as to a device of 64-bit tables only (the Arduino Uno): "
+                    "in pieces, the prepared lines it could not hold (with --prepare-on-host)");
   command->add_option("--svg", o->svg, "sim: write what the plotter drew as SVG");
   command->add_option("--png", o->png, "sim: draw what the plotter drew as a PNG picture");
   command->add_option("--waveform", o->waveform,
@@ -358,6 +361,9 @@ int RunStream(const StreamOptions& options) {
     throw InputError(
         "--svg, --png, --waveform, --faults and --sim-cost are for --device sim (--svg, --png "
         "and --waveform also for --dry-run)");
+  }
+  if (o.sim_64bit_tables && (!sim || !o.prepare_on_host)) {
+    throw InputError("--sim-64bit-tables is for --device sim with --prepare-on-host");
   }
   if ((sim || o.dry_run) && o.tick_hz != 0 && 1'000'000 % o.tick_hz != 0) {
     throw InputError("--tick-hz: " + std::to_string(o.tick_hz) + " does not divide 1000000" +

@@ -75,6 +75,12 @@ struct StreamOptions {
   /// sim: what the device's validation costs in virtual time: "none" or
   /// "atmega2560" (16 MHz, the cycles measured under simavr).
   std::string sim_cost = "none";
+  /// sim: the simulated device takes the job as a device that steps 64-bit
+  /// tables only (HELLO's protocol::kFeature64BitTables, the Arduino Uno)
+  /// is sent it: every prepared line it could not hold, in pieces
+  /// (SplitForSixtyFourBitTables). The reference of such a board's
+  /// end-to-end test (tests/boards/run_e2e.py).
+  bool sim_64bit_tables = false;
   std::uint64_t seed = 1;
   std::string svg;
   std::string png;

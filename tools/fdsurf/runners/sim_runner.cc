@@ -345,8 +345,11 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
 
 }  // namespace
 
-int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
+int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& planned,
                  const ToolpathOptions& drawing, const std::string& units) {
+  // As a board of 64-bit tables is sent it (FitJobToDevice): the same pieces.
+  StreamJob job = planned;
+  if (o.sim_64bit_tables) SplitForSixtyFourBitTables(&job);
   const sim::PlotterOptions plotter_options = PlotterOptionsFor(o, o.tick_hz);
   CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
   sim::SimulatedPlotter plotter(plotter_options);
