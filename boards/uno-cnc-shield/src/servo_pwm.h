@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+// The pen as a hobby servo on D11 = PB3 = OC2A (Grbl 1.1's spindle PWM pin,
+// which Grbl's servo forks drive a pen lift from), made by Timer2.
+//
+// Timer2 is 8 bits wide. Fast PWM at clock / 1024 would give one pulse every
+// 16.4 ms (61 Hz) in steps of 64 us: a 1000..2000 us servo would have 16
+// positions. Instead Timer2 runs in fast PWM (mode 3, TOP = 255) at
+// clock / 256: one count is 16 us, one timer period 4.096 ms, long enough
+// for any pulse of 500..2500 us. The output OC2A is connected (non-
+// inverting: set at BOTTOM, cleared at the compare match) for one timer
+// period in five, so the servo sees one pulse every 20.48 ms (48.8 Hz), in
+// steps of 16 us (a 1000..2000 us servo has 63 positions). Both edges come
+// from the timer's hardware: no interrupt latency moves them.
+//
+// The gating runs in TIMER2_COMPA_vect, just after each period's compare
+// match, when the pin is low either way: it connects OC2A for the period
+// that follows (and loads the width the pen wants), or disconnects it (the
+// pin is then PORTB3 = 0). It has until the next BOTTOM, 1.6 ms or more
+// after the compare, to do so; the step interrupt, the longest section
+// with interrupts masked, takes about 0.1 ms.
+#pragma once
+
+#include <avr/io.h>
+#include <stdint.h>
+
+#include "board_config.h"
+#include "fdsurf/hal/outputs.h"
+
+namespace fdsurf {
+namespace uno {
+
+class ServoPen final : public hal::PenOutput {
+ public:
+  /// Timer2 periods between two pulses: 5 x 4.096 ms = 20.48 ms.
+  static constexpr uint8_t kPeriodsPerPulse = 5;
+  /// One Timer2 count (clock / 256), microseconds.
+  static constexpr uint16_t kCountUs = 16;
+
+  ServoPen() = default;
+  ~ServoPen() = default;
+
+  /// OCR2A for a pulse of `us` microseconds (500..2500), to the nearest
+  /// count: the pulse is OCR2A + 1 counts long.
+  static constexpr uint8_t CompareFor(uint16_t us) {
+    return static_cast<uint8_t>((us + kCountUs / 2) / kCountUs - 1);
+  }
+
+  /// Starts Timer2 with OC2A disconnected (the pin low); the first pulse,
+  /// "pen up", starts within 20.5 ms. Called once, from SetSafeOutputs().
+  static void Start() {
+    PORTB &= static_cast<uint8_t>(~_BV(PB3));
+    DDRB |= _BV(PB3);
+    OCR2A = CompareFor(kServoUpUs);
+    TCNT2 = 0;
+    TCCR2A = _BV(WGM21) | _BV(WGM20);
+    TCCR2B = _BV(CS22) | _BV(CS21);
+    TIFR2 = _BV(TOV2) | _BV(OCF2A);
+    TIMSK2 = _BV(OCIE2A);
+  }
+
+  /// Call from TIMER2_COMPA_vect.
+  void OnCompare() {
+    // A compare without an overflow since the last one is the same period's
+    // again: simavr re-arms the compare when OCR2A is written mid-period
+    // (the hardware buffers OCR2A until BOTTOM and matches once).
+    if ((TIFR2 & _BV(TOV2)) == 0) return;
+    TIFR2 = _BV(TOV2);
+    if (++phase_ == kPeriodsPerPulse) phase_ = 0;
+    if (phase_ != kPeriodsPerPulse - 1) {
+      TCCR2A = _BV(WGM21) | _BV(WGM20);  // OC2A off: the pin stays low
+      return;
+    }
+    // The width first, with OC2A still off: simavr applies an OCR2A write
+    // at once, and would set the pin at a compare still ahead in this
+    // period if OC2A were already on.
+    OCR2A = next_compare_;
+    TCCR2A = _BV(COM2A1) | _BV(WGM21) | _BV(WGM20);
+  }
+
+ private:
+  // Runs in the step interrupt, which the compare interrupt cannot cut
+  // into (and the other way round): one byte, taken at the next pulse.
+  hal::IoStatus DoSetPen(bool down) override {
+    down_ = down;
+    next_compare_ = CompareFor(down ? down_us_ : up_us_);
+    return hal::IoStatus::kOk;
+  }
+  // Also from the step interrupt (Device::Tick), before any pen change; the
+  // pen moves to the new width of the state it is in. Both 0: the image's.
+  hal::IoStatus DoConfigureServo(uint16_t up_us, uint16_t down_us) override {
+    const bool image_widths = up_us == 0 && down_us == 0;
+    up_us_ = image_widths ? kServoUpUs : up_us;
+    down_us_ = image_widths ? kServoDownUs : down_us;
+    return DoSetPen(down_);
+  }
+  FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
+
+  volatile uint8_t next_compare_ = CompareFor(kServoUpUs);
+  uint8_t phase_ = 0;
+  uint16_t up_us_ = kServoUpUs;
+  uint16_t down_us_ = kServoDownUs;
+  bool down_ = false;
+};
+
+}  // namespace uno
+}  // namespace fdsurf
