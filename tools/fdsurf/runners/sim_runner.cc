@@ -345,19 +345,19 @@ void PrintReport(const StreamOptions& o, const PatchSet& set, const StreamJob& j
 
 }  // namespace
 
-int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& planned,
+int RunSimulated(const StreamOptions& o, const PatchSet& set, const StreamJob& job,
                  const ToolpathOptions& drawing, const std::string& units) {
   // As a board of 64-bit tables is sent it (FitJobToDevice): the same pieces.
-  StreamJob job = planned;
-  if (o.sim_64bit_tables) SplitForSixtyFourBitTables(&job);
+  StreamJob sent = job;
+  if (o.sim_64bit_tables) SplitForSixtyFourBitTables(&sent);
   const sim::PlotterOptions plotter_options = PlotterOptionsFor(o, o.tick_hz);
-  CheckSpeedAgainstTicks(job, plotter_options.tick_hz, o);
+  CheckSpeedAgainstTicks(sent, plotter_options.tick_hz, o);
   sim::SimulatedPlotter plotter(plotter_options);
-  const sim::RunResult run = StreamToPlotter(o, job, &plotter, PlotterRun{});
+  const sim::RunResult run = StreamToPlotter(o, sent, &plotter, PlotterRun{});
   if (!run.finished) throw DeviceError("sim device: " + DecodeDeviceError(run.error));
-  const CheckedDrawing checked = CheckDrawing(plotter, set, job, plotter_options.tick_hz, o.dims);
-  WriteDrawing(o, job, plotter, checked.drawn);
-  if (!o.quiet) PrintReport(o, set, job, drawing, units, plotter_options, run, checked);
+  const CheckedDrawing checked = CheckDrawing(plotter, set, sent, plotter_options.tick_hz, o.dims);
+  WriteDrawing(o, sent, plotter, checked.drawn);
+  if (!o.quiet) PrintReport(o, set, sent, drawing, units, plotter_options, run, checked);
   return checked.within && checked.limits_kept ? 0 : 1;
 }
 
