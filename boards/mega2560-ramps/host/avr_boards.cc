@@ -26,6 +26,7 @@ constexpr AvrBoard kMega{
     0xC0,
     0xC4,  // UCSR0A, UBRR0
     0x3E,  // GPIOR0
+    0,     // no count of lost received bytes
     0x200,
     0x21FF,  // 8 KB
     1000,
@@ -64,6 +65,7 @@ constexpr AvrBoard kUno{
     0xC0,
     0xC4,  // UCSR0A, UBRR0
     0x3E,  // GPIOR0
+    0x4A,  // GPIOR1: received bytes lost to a full ring
     0x100,
     0x8FF,  // 2 KB
     1000,

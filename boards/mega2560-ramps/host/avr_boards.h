@@ -54,6 +54,9 @@ struct AvrBoard {
   std::uint16_t ucsra;
   std::uint16_t ubrr;
   std::uint16_t gpior0;
+  // Where the firmware counts the received bytes its ring had no room for
+  // (saturating at 255; the Uno: GPIOR1), or 0: it does not say.
+  std::uint16_t rx_overruns;
   // The internal RAM, first and last byte (data space).
   std::uint16_t ram_start;
   std::uint16_t ram_end;

@@ -248,6 +248,10 @@ bool Recorder::WriteMeasures(const std::string& path, avr_t* avr, const ImageFac
   Row(f, "late_ticks", static_cast<double>(late_ticks_), "ticks");
   Row(f, "lost_ticks", static_cast<double>(lost_ticks_), "ticks");
   Stats(f, "rx_isr", rx_);
+  if (board_.rx_overruns != 0) {
+    Row(f, "rx_overruns", avr->data[board_.rx_overruns],
+        "bytes lost to a full ring (255: or more)");
+  }
   const Accumulated& a = first_step_;
   const Accumulated& b = last_step_;
   const double window = static_cast<double>(b.cycle - a.cycle);

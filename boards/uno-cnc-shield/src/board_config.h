@@ -78,10 +78,11 @@ constexpr size_t kReplyBytes = 64;
 /// again: a point costs about 20 000 cycles here (1.3 ms), so 2 keep a
 /// round at about 2.5 ms, under the 5.6 ms the receive ring holds.
 constexpr uint16_t kFillBatch = 2;
-/// The UART receive ring (bytes): 64 is 5.6 ms of line at 115200 bit/s.
-/// Without a planner the main loop never validates for long (a PREPARED_
-/// CURVE's check is one table's range, not a patch's lines), so 5.6 ms is
-/// enough; 128 bytes would take a fifth of what the stack has left.
+/// The UART receive ring (bytes): 64 is 5.6 ms of line at 115200 bit/s,
+/// and no byte was lost in the end-to-end runs (the harness's rx_overruns);
+/// with 32 (2.8 ms) the CI job lost 4 bytes to a full ring while a new curve
+/// was started (their frames were resent). 128 would take 64 of the bytes
+/// the stack keeps clear (README.md, "RAM").
 constexpr uint8_t kRxRing = 64;
 
 /// Step pulse high time and DIR-to-STEP set-up, in CPU cycles at 16 MHz:

@@ -163,7 +163,16 @@ extern "C" void SaveResetCause() {
 
 ISR(TIMER2_COMPA_vect) { fdsurf::uno::g_pen.OnCompare(); }
 
-ISR(USART_RX_vect) { (void)fdsurf::uno::g_rx.Push(UDR0); }
+// A byte that finds the ring full is lost (the link protocol resends its
+// frame); the count of them, saturating at 255, is kept in GPIOR1, a
+// general-purpose I/O register that costs no RAM, where the simavr harness
+// reads it (rx_overruns).
+ISR(USART_RX_vect) {
+  if (!fdsurf::uno::g_rx.Push(UDR0)) {
+    const uint8_t lost = GPIOR1;
+    if (lost != 0xFFu) GPIOR1 = static_cast<uint8_t>(lost + 1u);
+  }
+}
 
 ISR(TIMER1_COMPA_vect) {
   using namespace fdsurf::uno;
