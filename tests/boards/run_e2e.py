@@ -113,6 +113,23 @@ MICROBIT_LIMITS = [
           "no servo edge delayed beyond its handler's entry (its width moved)"),
 ]
 
+# Arduino Uno + CNC Shield v3 (fdsurf_simavr_board --board uno-cnc-shield
+# --measures, boards/uno-cnc-shield/README.md): the Mega's promises, on 2 KB
+# of RAM, and no received byte lost to a full ring (the firmware counts them
+# in GPIOR1). The stack's deepest path (a PREPARED_CURVE's check with the
+# step interrupt on top: 522 + 144 bytes by the call graph) leaves about 60
+# of the 736 bytes the static RAM leaves it; the runs measured 72 to 114
+# bytes never used. 48 catches a change that deepens it by a few dozen.
+UNO_LIMITS = [
+    Limit("late_ticks", "==", 0, "no step interrupt began a period after its compare match"),
+    Limit("lost_ticks", "==", 0, "no compare match lost (2000 Hz is the rate it holds)"),
+    Limit("watchdog_resets", "==", 0, "the main loop never stalled for the watchdog"),
+    Limit("boots", "==", 1, "one start: no reset mid-job (a resume after one is refused)"),
+    Limit("rx_overruns", "==", 0, "no received byte lost to a full ring"),
+    Limit("stack_high_water", ">=", 256, "the paint was read: the job used the stack"),
+    Limit("ram_never_used", ">=", 48, "the stack stays 48 B clear of the static RAM"),
+]
+
 # Per board: the baud of its UART, the step timing its drivers need (RAMPS:
 # DRV8825, 1.9 us pulse and 650 ns DIR set-up; A4988 elsewhere: 1 us, 200 ns),
 # the pen servo's widths built into the image (us, up and down; None: a pen
@@ -127,6 +144,23 @@ BOARDS = {
                        "limits": MEGA_LIMITS,
                        "job_args": "--fit 20x15 --lines 2 --speed 20 "
                                    "--servo-pulse-up 1200 --servo-pulse-down 1800"},
+    # The Uno has no planner: the host prepares every line (--prepare-on-host)
+    # and sends the ones its 64-bit tables cannot hold in pieces; the
+    # reference is given the same pieces (--sim-64bit-tables), whose joins
+    # make moves of their own. Its job is a short teapot (the teapot's 32
+    # patches, 2 t-lines each, on a 20 x 15 mm page, pen delay 20 ms: 7.8 s
+    # of machine time for the simulated plotter; the Uno, without turn caps,
+    # runs at 607 steps/s at most and takes about 37 s). Its servo (Timer2,
+    # servo_pwm.h) pulses every 20.48 ms in steps of 16 us: 1800 us is made
+    # as 1808, so a width within 10 us (half a step, and the 2 us every
+    # board is allowed) of the profile's is exact.
+    "uno-cnc-shield": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
+                       "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
+                       "servo_period_ns": 20_480_000, "servo_width_slack_us": 10,
+                       "reference_args": ["--sim-64bit-tables"],
+                       "limits": UNO_LIMITS,
+                       "job_args": "--prepare-on-host --fit 20x15 --lines 0x2 --speed 20 "
+                                   "--pen-delay 20 --servo-pulse-up 1200 --servo-pulse-down 1800"},
     "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
                     "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
                     "limits": MICROBIT_LIMITS,
@@ -135,10 +169,12 @@ BOARDS = {
     "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
                 "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 2"},
 }
-# A servo pulse starts every 20 ms (50 Hz); under simavr a width written at a
+# A servo pulse starts every 20 ms (50 Hz; a board's "servo_period_ns" says
+# otherwise); under simavr a width written at a
 # period's start can shift that start by the interrupt latency, and servos
 # take 40-60 Hz anyway. A width within 2 us of the profile's is exact (the
-# waveform's 62.5 ns cycle and the rounding to us).
+# waveform's 62.5 ns cycle and the rounding to us), or within a board's
+# "servo_width_slack_us" where its PWM cannot make the width exactly.
 SERVO_PERIOD_NS = 20_000_000
 SERVO_PERIOD_SLACK_NS = 1_000_000
 SERVO_WIDTH_SLACK_US = 2
@@ -239,9 +275,12 @@ def run_logged(processes, name, command, timeout_s):
 
 
 def reference(args, processes, tick_hz, ref):
-    """The simulated plotter at the board's tick rate; returns its machine time."""
+    """The simulated plotter at the board's tick rate, given the job as the
+    board is given it (the board's "reference_args"); returns its machine
+    time."""
     command = [args.fdsurf, "stream", args.job, "--device", "sim", "--waveform", ref,
-               "--tick-hz", str(tick_hz), "-q"] + args.job_args
+               "--tick-hz", str(tick_hz), "-q"] + args.job_args + \
+        BOARDS[args.board].get("reference_args", [])
     code = run_logged(processes, "reference", command, 120)
     if code != 0:
         raise Failure("the reference run (fdsurf stream --device sim) exited with %d" % code)
@@ -396,14 +435,16 @@ def check_enable_released(header, transitions):
     return "%s released at reset" % " ".join(sorted(first))
 
 
-def check_servo(header, transitions, servo_us, job_us=None, pen_lowered=True):
+def check_servo(header, transitions, servo_us, job_us=None, pen_lowered=True,
+                period_ns=SERVO_PERIOD_NS, width_slack_us=SERVO_WIDTH_SLACK_US):
     """A servo pen: the header names the image's widths `servo_us`; every
     pulse is exactly one of the job's widths (`job_us`, the CONFIG's; None:
     the image's), except the image's pen-up pulses before the first of them
     (the board starts before the CONFIG arrives); pulses start one period
     apart, and both job widths were seen (the pen went down and up), or the
     pen-up width alone when the job was stopped before its pen first went
-    down (`pen_lowered` False)."""
+    down (`pen_lowered` False). `period_ns` and `width_slack_us`: the
+    board's period and how close to a width its PWM can come."""
     declared = header_value(header, "pen")
     if declared != ["servo"] + [str(us) for us in servo_us]:
         raise Failure("the recording's header says '# pen %s', the image's 'servo %d %d'" %
@@ -415,18 +456,18 @@ def check_servo(header, transitions, servo_us, job_us=None, pen_lowered=True):
         if name != "SERVO":
             continue
         if level == 1:
-            if last_rise is not None and abs(time_ns - last_rise - SERVO_PERIOD_NS) > \
+            if last_rise is not None and abs(time_ns - last_rise - period_ns) > \
                     SERVO_PERIOD_SLACK_NS:
                 raise Failure("servo pulses %d ns apart at %d ns, not %d" %
-                              (time_ns - last_rise, time_ns, SERVO_PERIOD_NS))
+                              (time_ns - last_rise, time_ns, period_ns))
             rise = last_rise = time_ns
         elif rise is not None:
             width_us = (time_ns - rise) / 1000
             rise = None
-            if not seen and abs(width_us - image_up_us) <= SERVO_WIDTH_SLACK_US:
+            if not seen and abs(width_us - image_up_us) <= width_slack_us:
                 continue  # before the CONFIG took effect
             nearest = min(servo_us, key=lambda us: abs(us - width_us))
-            if abs(width_us - nearest) > SERVO_WIDTH_SLACK_US:
+            if abs(width_us - nearest) > width_slack_us:
                 raise Failure("a servo pulse of %.1f us at %d ns: not up/down %s us" %
                               (width_us, last_rise, servo_us))
             seen.add(nearest)
@@ -434,9 +475,10 @@ def check_servo(header, transitions, servo_us, job_us=None, pen_lowered=True):
         raise Failure("servo pulses of %s us only, expected %s" %
                       (sorted(seen), "both %s" % (servo_us,) if pen_lowered else servo_us[0]))
     if not pen_lowered:
-        return "servo pulses %d us every 20 ms (stopped before the pen first went down)" % \
-            servo_us[0]
-    return "servo pulses %d/%d us every 20 ms" % servo_us
+        return "servo pulses %d us every %g ms (stopped before the pen first went down)" % \
+            (servo_us[0], period_ns / 1e6)
+    return "servo pulses %d/%d us (within %d us) every %g ms" % (servo_us + (width_slack_us,
+                                                                           period_ns / 1e6))
 
 
 def pen_lowered(args, rec):
@@ -456,7 +498,9 @@ def check_board(args, board, rec, measures_path, hello_tick_hz):
     report = [check_enable_released(header, transitions)]
     if board["servo_us"]:
         report.append(check_servo(header, transitions, board["servo_us"],
-                                  board.get("job_servo_us"), pen_lowered(args, rec)))
+                                  board.get("job_servo_us"), pen_lowered(args, rec),
+                                  board.get("servo_period_ns", SERVO_PERIOD_NS),
+                                  board.get("servo_width_slack_us", SERVO_WIDTH_SLACK_US)))
     if board["limits"] is not None:
         report += check_measures(read_measures(measures_path), board["limits"], args.scenario,
                                  hello_tick_hz, measures_path)

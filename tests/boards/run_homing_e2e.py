@@ -11,8 +11,8 @@ above its min switches (--endstop-start) and the relay puts its UART on a
 pty LINK. Then, each one a separate `fdsurf` process that opens the link
 anew (the board must keep its state between them: it is not reset):
 
-1. `fdsurf stream JOB --require-homing` on the unhomed board: refused, exit
-   3, a message naming "not homed";
+1. `fdsurf stream JOB --require-homing` (and --stream-args) on the unhomed
+   board: refused, exit 3, a message naming "not homed";
 2. `fdsurf machine home --travel ...`: exit 0;
 3. `fdsurf machine where`: position 0, 0 steps, homed xy;
 4. the harness is stopped and its recording is read: on each axis the
@@ -37,6 +37,7 @@ the firmware. Every process runs under a timeout. Exit 0 pass, 1 fail.
 import argparse
 import os
 import re
+import shlex
 import sys
 import time
 
@@ -65,7 +66,7 @@ def machine(args, processes, name, action, extra, timeout_s):
 def refused_unhomed(args, processes):
     command = [args.fdsurf, "stream", args.job, "--device", "serial:%s:%d" % (args.link, BAUD),
                "--step", str(STEP_MM), "--travel", TRAVEL, "--fit", "20x15", "--lines", "2",
-               "--require-homing", "-q"]
+               "--require-homing", "-q"] + shlex.split(args.stream_args)
     code = run_e2e.run_logged(processes, "unhomed", command, 120)
     with open(os.path.join(processes.workdir, "unhomed.log")) as f:
         output = f.read()
@@ -200,6 +201,9 @@ def main():
     parser.add_argument("--relay", required=True)
     parser.add_argument("--job", required=True, help="a patch file (refused unhomed)")
     parser.add_argument("--elf", required=True)
+    parser.add_argument("--stream-args", default="",
+                        help="more fdsurf stream options for the unhomed job, one string "
+                             "(--prepare-on-host for a board without a planner, the Uno)")
     parser.add_argument("--scenario", choices=("home", "hardlimit"), default="home")
     parser.add_argument("--start",
                         help="steps from each min switch at start, X,Y (default 300,200; "
