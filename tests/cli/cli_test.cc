@@ -315,6 +315,24 @@ TEST_F(Cli, StreamChargesTheDevicesComputeTimeOnRequest) {
   EXPECT_EQ(free.err.find("of its main loop validating commands"), std::string::npos) << free.err;
 }
 
+// --sim-64bit-tables gives the simulated plotter the job as the Uno (a
+// device of 64-bit tables only) is given it: the prepared lines it could
+// not hold in pieces, drawn within the same bound (the reference of the
+// Uno's end-to-end tests, tests/boards/run_e2e.py).
+TEST_F(Cli, StreamSendsTheSimTheUnosPiecesOnRequest) {
+  const std::string job = "stream '" + kTeapot +
+                          "' --fit 20x15 --lines 0x2 --tick-hz 2000 --speed 20 --prepare-on-host";
+  const RunResult whole = Run(job);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_NE(whole.err.find("(130 commands,"), std::string::npos) << whole.err;
+  const RunResult pieces = Run(job + " --sim-64bit-tables");
+  ASSERT_EQ(pieces.exit_code, 0) << pieces.err;
+  EXPECT_NE(pieces.err.find("(136 commands,"), std::string::npos) << pieces.err;
+  EXPECT_NE(pieces.err.find("(--tolerance): within"), std::string::npos) << pieces.err;
+  ExpectRefused("stream '" + kTeapot + "' --sim-64bit-tables",
+                "--sim-64bit-tables is for --device sim with --prepare-on-host");
+}
+
 TEST_F(Cli, StreamRefusesBadOptionsAndMissingDevices) {
   ExpectRefused("stream '" + kTeapot + "' --device serial", "--device: 'serial' is not sim");
   ExpectRefused("stream '" + kTeapot + "' --device usb --faults 0.1",
