@@ -17,7 +17,7 @@
 // that follows (and loads the width the pen wants), or disconnects it (the
 // pin is then PORTB3 = 0). It has until the next BOTTOM, 1.6 ms or more
 // after the compare, to do so; the step interrupt, the longest section
-// with interrupts masked, takes about 0.1 ms.
+// with interrupts masked, takes 0.14 ms at most (2 204 cycles measured).
 #pragma once
 
 #include <avr/io.h>
