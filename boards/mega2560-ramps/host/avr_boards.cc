@@ -48,6 +48,8 @@ constexpr AvrBoard kMega{
         {'Y', F(6), F(7), J(1), true, J(0)},
         {'Z', L(3), L(1), D(3), true, D(2)},
     },
+    // No other output shares PORTB with the servo: its pin is recorded.
+    {0, 0, 0, 0},
 };
 
 // Arduino Uno + CNC Shield v3 (boards/uno-cnc-shield/src/shield_outputs.h,
@@ -87,6 +89,7 @@ constexpr AvrBoard kUno{
         {'Y', D(3), D(6), B(2), false, B(2)},
         {'Z', D(4), D(7), B(4), false, B(4)},
     },
+    {'2', 0, 0xB0, 0xC0},  // OC2A; TCCR2A's COM2A1:0
 };
 
 const AvrBoard* const kBoards[] = {&kMega, &kUno};

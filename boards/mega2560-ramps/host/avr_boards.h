@@ -38,6 +38,19 @@ struct AvrAxis {
   AvrPin max;  // held released; unused without has_max
 };
 
+/// The timer output compare that drives the servo pin, where the waveform
+/// must follow the timer rather than the pin's IRQ: simavr raises every
+/// output pin of a port from its PORT register on any write to it, also a
+/// pin an output compare drives, which the hardware leaves to the timer (the
+/// Uno's ENABLE on PB0 shares PORTB with its servo on OC2A = PB3, so an
+/// enable cut the pulse short in the recording alone). timer 0: none.
+struct AvrServoTimer {
+  char timer;                 // simavr's timer name: '1', '2', ...
+  std::uint8_t compare;       // 0: A, 1: B
+  std::uint16_t tccra;        // data-space address of TCCRnA
+  std::uint8_t connect_mask;  // its COMnx bits: the pin follows the timer while any is set
+};
+
 struct AvrBoard {
   static constexpr int kSignals = 10;
 
@@ -65,6 +78,8 @@ struct AvrBoard {
   std::uint16_t servo_down_us;
   AvrSignal signals[kSignals];
   AvrAxis axes[3];
+  /// The SERVO signal's timer (signals[] names its pin).
+  AvrServoTimer servo_timer;
 
   [[nodiscard]] std::uint32_t RamBytes() const {
     return static_cast<std::uint32_t>(ram_end - ram_start + 1u);

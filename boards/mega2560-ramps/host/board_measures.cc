@@ -2,6 +2,7 @@
 #include "board_measures.h"
 
 #include <avr_ioport.h>
+#include <avr_timer.h>
 #include <avr_uart.h>
 #include <sim_elf.h>
 #include <sim_interrupts.h>
@@ -10,6 +11,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string>
 
 namespace fdsurf::board {
 namespace {
@@ -55,8 +57,14 @@ void Recorder::Attach(avr_t* avr) {
   avr_ = avr;
   g_recorder = this;
   for (int i = 0; i < kSignals; ++i) {
-    signals_[i] = Signal{board_.signals[i], this, false, 0};
+    const bool servo = std::string(board_.signals[i].name) == "SERVO";
+    signals_[i] = Signal{board_.signals[i], this, false, 0, servo && board_.servo_timer.timer != 0};
     Signal* s = &signals_[i];
+    if (s->timer_driven) {
+      avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_TIMER_GETIRQ(board_.servo_timer.timer),
+                                            TIMER_IRQ_OUT_COMP + board_.servo_timer.compare),
+                              OnServoTimer, s);
+    }
     avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ(s->line.pin.port),
                                           IOPORT_IRQ_PIN0 + s->line.pin.bit),
                             OnPin, s);
@@ -94,14 +102,30 @@ void Recorder::Write(const Signal& signal) {
                signal.line.name, signal.level);
 }
 
-void Recorder::OnPin(avr_irq_t*, std::uint32_t value, void* param) {
-  auto* s = static_cast<Signal*>(param);
-  const int level = (value & 1u) != 0 ? 1 : 0;
+void Recorder::Record(Signal* s, int level) {
   if (!s->started || level == s->level) return;
   s->level = level;
-  Recorder* r = s->recorder;
-  r->Write(*s);
-  if (s->line.step && level == 1 && r->in_tick_) r->stepped_ = true;
+  Write(*s);
+  if (s->line.step && level == 1 && in_tick_) stepped_ = true;
+}
+
+bool Recorder::ServoTimerConnected() const {
+  return (avr_->data[board_.servo_timer.tccra] & board_.servo_timer.connect_mask) != 0;
+}
+
+void Recorder::OnPin(avr_irq_t*, std::uint32_t value, void* param) {
+  auto* s = static_cast<Signal*>(param);
+  // A timer-driven pin follows its timer while connected (OnServoTimer).
+  if (s->timer_driven && s->recorder->ServoTimerConnected()) return;
+  s->recorder->Record(s, (value & 1u) != 0 ? 1 : 0);
+}
+
+// The output compare's level as the timer sets and clears it (at BOTTOM
+// and at the match in fast PWM); simavr raises it only while connected.
+void Recorder::OnServoTimer(avr_irq_t*, std::uint32_t value, void* param) {
+  auto* s = static_cast<Signal*>(param);
+  if (!s->recorder->ServoTimerConnected()) return;
+  s->recorder->Record(s, (value & 1u) != 0 ? 1 : 0);
 }
 
 // A line enters the waveform when the firmware makes it an output, with the

@@ -80,11 +80,17 @@ class Recorder {
     Recorder* recorder;
     bool started;  // set up as an output: its changes are recorded
     int level;
+    // The servo pin of a board with a servo timer: while the timer drives
+    // it, its level is the timer's output, not the pin's IRQ.
+    bool timer_driven;
   };
   static constexpr int kSignals = AvrBoard::kSignals;
 
  private:
   static void OnPin(avr_irq_t* irq, std::uint32_t value, void* param);
+  static void OnServoTimer(avr_irq_t* irq, std::uint32_t value, void* param);
+  void Record(Signal* signal, int level);
+  [[nodiscard]] bool ServoTimerConnected() const;
   static void OnDirection(avr_irq_t* irq, std::uint32_t value, void* param);
   static void OnTickPending(avr_irq_t* irq, std::uint32_t value, void* param);
   static void OnTickRunning(avr_irq_t* irq, std::uint32_t value, void* param);
