@@ -110,6 +110,19 @@ TEST(MotionLoop, StraightRunIsATrapezoidWithinTheLimits) {
   }
 }
 
+// Every unit move's length is √k·2^24 rounded up for the k axes it steps
+// (never shorter than the move), computed here in long double.
+TEST(MotionLoop, AMoveIsAsLongAsTheRootOfTheAxesItSteps) {
+  for (int code = 0; code < 27; ++code) {
+    const std::int32_t delta[3] = {code % 3 - 1, code / 3 % 3 - 1, code / 9 - 1};
+    const int axes = (delta[0] != 0) + (delta[1] != 0) + (delta[2] != 0);
+    const long double exact = std::sqrt(static_cast<long double>(axes)) * 16777216.0L;
+    const std::uint32_t length = motion::LengthOfMove(motion::MakeMove(delta, 3));
+    EXPECT_GE(static_cast<long double>(length), exact) << code;
+    EXPECT_LT(static_cast<long double>(length), exact + 1) << code;
+  }
+}
+
 TEST(MotionLoop, DiagonalMovesCountTheirLength) {
   std::vector<std::uint8_t> storage(4096);
   MotionLoop loop(storage.data(), 4096);

@@ -242,16 +242,23 @@ Status PrepareLine(const PowerCurve1 (&relative)[kDims], uint32_t tolerance_q8, 
 
 // The planner (or, for a prepared curve, the check of the host's level) must
 // accept the line as execution steps it (relative to its first point), and
-// every point it will emit must lie within the travel.
+// every point it will emit must lie within the travel. `curve` is made
+// relative in place for the first check and restored for the second (whole
+// steps taken off and added back: exact), so that a caller holding its own
+// copy (a PREPARED_CURVE's, on the Uno's small stack) needs no second one.
 template <int kDims>
-ErrorCode CheckLine(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
-                    const protocol::MachineConfig& config, uint8_t* detail, ValidationWork* work) {
-  PreparedAdaptiveCurve<kDims, TableEntry> prepared;
-  PowerCurve1 relative[kDims];
+ErrorCode CheckLineInPlace(PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level,
+                           const protocol::MachineConfig& config, uint8_t* detail,
+                           ValidationWork* work) {
   int32_t first[kDims];
-  RelativeToFirstPoint(curve, relative, first);
+  RelativeToFirstPoint(curve, curve, first);
   if (work != nullptr) ++(host_level < 0 ? work->lines : work->prepared_lines);
-  const Status status = PrepareLine(relative, tolerance_q8, host_level, &prepared);
+  Status status;
+  {
+    PreparedAdaptiveCurve<kDims, TableEntry> prepared;
+    status = PrepareLine(curve, tolerance_q8, host_level, &prepared);
+  }
+  for (int c = 0; c < kDims; ++c) curve[c].c[3] += static_cast<int64_t>(first[c]) * kOneStep;
   if (status != Status::kOk) {
     *detail = static_cast<uint8_t>(status);
     return ErrorCode::kPlannerRefused;
@@ -273,7 +280,7 @@ FDSURF_OUT_OF_LINE_ON_AVR ErrorCode CheckPreparedCurve(const protocol::PreparedC
   if (curve.dims != kDims) return ErrorCode::kDimsMismatch;
   PowerCurve1 power[kDims];
   for (int c = 0; c < kDims; ++c) power[c] = curve.power[c];
-  return CheckLine(power, curve.tolerance_q8, curve.level, config, detail, work);
+  return CheckLineInPlace(power, curve.tolerance_q8, curve.level, config, detail, work);
 }
 
 #if FDSURF_DEVICE_PLANNER
@@ -290,7 +297,7 @@ FDSURF_OUT_OF_LINE_ON_AVR ErrorCode CheckCurve(const protocol::CurveCommand& cur
     *detail = static_cast<uint8_t>(status);
     return ErrorCode::kPlannerRefused;
   }
-  return CheckLine(power, curve.tolerance_q8, kPlannerLevel, config, detail, work);
+  return CheckLineInPlace(power, curve.tolerance_q8, kPlannerLevel, config, detail, work);
 }
 
 template <int kDims>
@@ -300,7 +307,9 @@ ErrorCode CheckFamily(const protocol::PatchCommand& patch, IsolineFamily family,
   ErrorCode error = ErrorCode::kNone;
   const Status walked =
       ForEachDrawnLine<kDims>(patch, family, [&](const PowerCurve1(&curve)[kDims]) {
-        error = CheckLine(curve, patch.tolerance_q8, kPlannerLevel, config, detail, work);
+        PowerCurve1 line[kDims];
+        for (int c = 0; c < kDims; ++c) line[c] = curve[c];
+        error = CheckLineInPlace(line, patch.tolerance_q8, kPlannerLevel, config, detail, work);
         return error == ErrorCode::kNone;
       });
   if (walked != Status::kOk) {

@@ -37,16 +37,16 @@ inline uint8_t MakeMove(const int32_t* delta, int axes) {
 
 /// Length units of the profile: 2^-24 steps of path length.
 constexpr int kLengthFracBits = 24;
-/// Lengths of a unit move that steps 1, 2 or 3 axes: √k·2^24 rounded up, so
-/// that a diagonal move is never taken as shorter than it is.
-constexpr uint32_t kMoveLength[4] = {0, 16777216u, 23726567u, 29058991u};
-
-/// The length of a unit move entry, 2^-24 steps (kMoveLength of the axes
-/// it steps).
+/// The length of a unit move entry, 2^-24 steps: √k·2^24 rounded up for a
+/// move that steps k axes, so that a diagonal move is never taken as
+/// shorter than it is. (Chosen by comparisons rather than read from a
+/// table: avr-gcc would keep a table in RAM.)
 inline uint32_t LengthOfMove(uint8_t move) {
   int axes = 0;
   for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
-  return kMoveLength[axes];
+  if (axes == 1) return 16777216u;   // 2^24
+  if (axes == 2) return 23726567u;   // ⌈√2·2^24⌉
+  return axes == 3 ? 29058991u : 0;  // ⌈√3·2^24⌉
 }
 
 }  // namespace motion

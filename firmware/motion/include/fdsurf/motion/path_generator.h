@@ -104,7 +104,7 @@ int StraightMoveLevel(const PowerCurve1 (&line)[kDims]);
 /// `first` = the first point rounded to steps, `relative` = the curve with
 /// first·2^16 taken from its constant term. Each point of the relative line
 /// plus `first` is the point of the line, bit for bit (round(x − k) =
-/// round(x) − k for a whole k).
+/// round(x) − k for a whole k). `relative` may be `curve` (in place).
 template <int kDims>
 void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relative)[kDims],
                           int32_t (&first)[kDims]);
