@@ -37,6 +37,9 @@ struct Options {
   bool prefix = false;
   std::int64_t min_pulse_ns = 1000;
   std::int64_t min_dir_setup_ns = 200;
+  /// The longest a servo pen's change waits for the pulse that carries it;
+  /// 0: one PWM period (the recording's longest).
+  std::int64_t servo_wait_ns = 0;
 };
 
 std::string Axes(const UnitMove& m) {
@@ -159,10 +162,15 @@ MotionLimitsSi LimitsFrom(const WaveformHeader& ref, const std::string& name) {
 
 // CheckMotion on REC, the end of the recording counted as a rest (the motion
 // must have come to rest within the acceleration limit, after a STOP too).
-MotionReport CheckRecordedMotion(const DecodedWaveform& rec, MotionLimitsSi limits) {
-  // A servo pen takes effect at its next pulse: up to one PWM period later.
+MotionReport CheckRecordedMotion(const DecodedWaveform& rec, MotionLimitsSi limits,
+                                 std::int64_t servo_wait_ns) {
+  // A servo pen takes effect at its next pulse: up to one PWM period later,
+  // or as long as the board says a change can wait for its pulse (the
+  // recording times the change at that pulse, the device's pen delay ran
+  // from the change itself).
   if (rec.timing.servo_period_ns > 0) {
-    limits.pen_delay_s = std::max(0.0, limits.pen_delay_s - rec.timing.servo_period_ns * 1e-9);
+    const std::int64_t wait = std::max(servo_wait_ns, rec.timing.servo_period_ns);
+    limits.pen_delay_s = std::max(0.0, limits.pen_delay_s - static_cast<double>(wait) * 1e-9);
   }
   std::vector<hal::PenEvent> pens = rec.pen_events;
   std::uint64_t last_step_us = 0;
@@ -236,7 +244,7 @@ int Check(const Options& o) {
   }
   PrintTiming(rec.timing, o);
   if (rec.timing.problems() > 0) failures.push_back(rec.timing.first_problem);
-  const MotionReport motion = CheckRecordedMotion(rec, limits);
+  const MotionReport motion = CheckRecordedMotion(rec, limits, o.servo_wait_ns);
   std::printf(
       "motion: top speed %.0f steps/s (limit %.0f), largest acceleration %.0f steps/s² (limit "
       "%.0f, windowed), %zu violations\n",
@@ -264,6 +272,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-dir-setup-ns", o.min_dir_setup_ns,
                  "shortest DIR change to STEP edge the drivers take")
+      ->capture_default_str();
+  app.add_option("--servo-wait-ns", o.servo_wait_ns,
+                 "longest a servo pen's change waits for its pulse (default: one PWM period)")
       ->capture_default_str();
   try {
     app.parse(argc, argv);
