@@ -118,11 +118,12 @@ def main():
               f"{img[1] + img[2]:,} | {img[3]} |")
     print()
 
-    # The whole device firmware (size/device.cc), and the same without the
-    # planner (size/device_prepared.cc: PREPARED_CURVE only).
-    print("### The device firmware, with and without the planner (bytes)\n")
-    print("| target | device: flash / static RAM | without the planner: flash / static RAM "
-          "| the planner's flash |")
+    # The whole device firmware (size/device.cc), and the same in the small
+    # chip's configuration (size/device_prepared.cc: PREPARED_CURVE only,
+    # 64-bit tables, no turn caps).
+    print("### The device firmware, whole and in the small chip's configuration (bytes)\n")
+    print("| target | device: flash / static RAM | no planner, 64-bit tables, no turn caps: "
+          "flash / static RAM | the flash they take |")
     print("|---|---|---|---|")
     for t in present:
         full = sizes.get((t, "device"))
