@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "board_config.h"
+#include "fdsurf/board/avr_runtime.h"
 #include "fdsurf/board/byte_ring.h"
 #include "fdsurf/device/device.h"
 #include "servo_pwm.h"
@@ -23,36 +24,22 @@
 #error "the Uno image links fdsurf_core_prepared (no planner, 64-bit tables): only that fits"
 #endif
 
-extern "C" {
-// avr-libc's linker script: the first free byte after .data and .bss.
-extern char __heap_start;
-// The abstract HAL bases' vtables name it; every class here overrides all.
-void __cxa_pure_virtual() {
-  for (;;) {
-  }
-}
-}
-
 namespace fdsurf {
 namespace uno {
 namespace {
 
-/// The value the free RAM is painted with at start; the stack's high-water
-/// mark is the lowest address that no longer holds it (the simavr harness
-/// reads it, boards/mega2560-ramps/host/board_measures.h).
-constexpr uint8_t kStackPaint = 0xA5;
 /// The step interrupt kicks the watchdog only while the main loop has gone
 /// round within this many ticks (or is inside Service()), so a hung main
 /// loop and a hung interrupt both reset the board.
 constexpr uint16_t kHeartbeatTicks = static_cast<uint16_t>(kTickHz / 4);
 
-/// Masks the step interrupt (all interrupts: SREG's I bit) while it lives.
-struct TickInterruptLock {
-  TickInterruptLock() : sreg_(SREG) { cli(); }
-  ~TickInterruptLock() { SREG = sreg_; }
-  TickInterruptLock(const TickInterruptLock&) = delete;
-  TickInterruptLock& operator=(const TickInterruptLock&) = delete;
-  uint8_t sreg_;
+/// The step interrupt's lock as a type of this file's own: a Device of an
+/// internal type is itself internal, so GCC inlines its Tick() and Fill(),
+/// each called once, into the interrupt and main() (with the shared type
+/// they stayed out of line: 486 bytes more on the Uno, 1 KB on the Mega,
+/// and a call in the step interrupt).
+struct TickInterruptLock : board::TickInterruptLock {
+  TickInterruptLock() {}  // NOLINT(modernize-use-equals-default): const objects
 };
 
 board::ByteRing<kRxRing> g_rx;
@@ -61,24 +48,9 @@ device::Device<kAxes, kQueueCapacity, kLookahead, TickInterruptLock,
     g_device(kTickHz);
 ShieldSteppers g_steppers;
 ShieldEndstops g_endstops;
-volatile uint16_t g_ticks_since_heartbeat = 0;
-volatile bool g_in_service = false;
+board::Heartbeat<kHeartbeatTicks> g_heartbeat;
 /// MCUSR at reset (why the board started), saved by SaveResetCause().
 volatile uint8_t g_reset_cause = 0;
-
-void PaintFreeRam() {
-  uint8_t* const sp = reinterpret_cast<uint8_t*>(SP);
-  for (uint8_t* p = reinterpret_cast<uint8_t*>(&__heap_start); p < sp - 32; ++p) *p = kStackPaint;
-}
-
-void StartUart() {
-  // U2X: 16 MHz / (8 (UBRR + 1)): 16 -> 117 647 bit/s (+2.1 %, as every
-  // Arduino sketch at 115200), 7 -> 250 000 exactly.
-  UCSR0A = _BV(U2X0);
-  UBRR0 = kBaud == 250000 ? 7 : 16;
-  UCSR0C = _BV(UCSZ01) | _BV(UCSZ00);
-  UCSR0B = _BV(RXEN0) | _BV(TXEN0) | _BV(RXCIE0);
-}
 
 void StartStepTimer() {
   TCCR1A = 0;
@@ -86,17 +58,6 @@ void StartStepTimer() {
   OCR1A = static_cast<uint16_t>(kTimerClockHz / kTickHz - 1);
   TCCR1B = _BV(WGM12) | _BV(CS11);  // CTC on OCR1A, clock / 8
   TIMSK1 = _BV(OCIE1A);
-}
-
-/// Transmission is polled: a reply is a few dozen bytes, the step interrupt
-/// runs while the main loop waits, and a transmit ring would cost RAM that
-/// the stack needs.
-void Send(const uint8_t* data, size_t size) {
-  for (size_t i = 0; i < size; ++i) {
-    while ((UCSR0A & _BV(UDRE0)) == 0) {
-    }
-    UDR0 = data[i];
-  }
 }
 
 /// What Device::Service() does with a hal::Transport, without its 64-byte
@@ -111,16 +72,8 @@ void ServiceLink() {
   uint8_t out[16];
   for (size_t n = g_device.ReadOutput(out, sizeof out); n != 0;
        n = g_device.ReadOutput(out, sizeof out)) {
-    Send(out, n);
+    board::SendUart0(out, n);
   }
-}
-
-void KeepAlive() {
-  {
-    const TickInterruptLock lock;
-    g_ticks_since_heartbeat = 0;
-  }
-  wdt_reset();
 }
 
 // Nothing to do until the next interrupt (a received byte or a tick): no
@@ -150,17 +103,6 @@ void SetSafeOutputs() {
 }  // namespace uno
 }  // namespace fdsurf
 
-// Before .bss is cleared and the constructors run: keep why the board
-// reset (in GPIOR0 until main() picks it up) and stop a watchdog that is
-// still running from before the reset, so that it cannot reset the board
-// again while it starts (it stays on at its shortest period after firing).
-extern "C" void SaveResetCause() __attribute__((naked, used, section(".init3")));
-extern "C" void SaveResetCause() {
-  GPIOR0 = MCUSR;
-  MCUSR = 0;
-  wdt_disable();
-}
-
 ISR(TIMER2_COMPA_vect) { fdsurf::uno::g_pen.OnCompare(); }
 
 // A byte that finds the ring full is lost (the link protocol resends its
@@ -178,28 +120,26 @@ ISR(TIMER1_COMPA_vect) {
   using namespace fdsurf::uno;
   // A failed output faults the device, which reports it in STATUS.
   (void)g_device.Tick(g_steppers, g_pen);
-  const uint16_t since = g_ticks_since_heartbeat;
-  if (since < kHeartbeatTicks || g_in_service) wdt_reset();
-  if (since != 0xFFFFu) g_ticks_since_heartbeat = static_cast<uint16_t>(since + 1);
+  g_heartbeat.OnTick();
 }
 
 int main() {
   using namespace fdsurf::uno;
-  g_reset_cause = GPIOR0;
+  g_reset_cause = fdsurf::board::ResetCause();
   SetSafeOutputs();
   SetUpEndstopPins();
   g_device.set_endstops(&g_endstops);
-  PaintFreeRam();
-  StartUart();
+  fdsurf::board::PaintFreeRam();
+  fdsurf::board::StartUart0(kBaud);
   StartStepTimer();
   wdt_enable(WDTO_500MS);
   set_sleep_mode(SLEEP_MODE_IDLE);
   sei();
   for (;;) {
-    KeepAlive();
-    g_in_service = true;
+    g_heartbeat.Beat();
+    g_heartbeat.set_in_service(true);
     ServiceLink();
-    g_in_service = false;
+    g_heartbeat.set_in_service(false);
     g_device.Fill(kFillBatch);
     if (NothingToDo()) {
       sleep_enable();
