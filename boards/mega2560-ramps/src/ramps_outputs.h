@@ -17,6 +17,7 @@
 #include <stdint.h>
 
 #include "board_config.h"
+#include "fdsurf/board/servo_widths.h"
 #include "fdsurf/hal/outputs.h"
 
 namespace fdsurf {
@@ -107,8 +108,8 @@ class ServoPen final : public hal::PenOutput {
  private:
   // Runs in the step interrupt, so the overflow interrupt cannot cut in.
   hal::IoStatus DoSetPen(bool down) override {
-    down_ = down;
-    next_compare_ = CompareFor(down ? down_us_ : up_us_);
+    widths_.set_down(down);
+    next_compare_ = CompareFor(widths_.WidthUs());
     TIFR1 = _BV(TOV1);  // an overflow flagged before now is not this period's start
     TIMSK1 |= _BV(TOIE1);
     return hal::IoStatus::kOk;
@@ -116,17 +117,13 @@ class ServoPen final : public hal::PenOutput {
   // Also from the step interrupt (Device::Tick), before any pen change; the
   // pen moves to the new width of the state it is in.
   hal::IoStatus DoConfigureServo(uint16_t up_us, uint16_t down_us) override {
-    const bool image_widths = up_us == 0 && down_us == 0;
-    up_us_ = image_widths ? kServoUpUs : up_us;
-    down_us_ = image_widths ? kServoDownUs : down_us;
-    return DoSetPen(down_);
+    widths_.Configure(up_us, down_us);
+    return DoSetPen(widths_.down());
   }
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
 
   volatile uint16_t next_compare_ = CompareFor(kServoUpUs);
-  uint16_t up_us_ = kServoUpUs;
-  uint16_t down_us_ = kServoDownUs;
-  bool down_ = false;
+  board::ServoWidths<kServoUpUs, kServoDownUs> widths_;
 };
 
 }  // namespace mega

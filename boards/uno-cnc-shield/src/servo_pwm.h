@@ -24,6 +24,7 @@
 #include <stdint.h>
 
 #include "board_config.h"
+#include "fdsurf/board/servo_widths.h"
 #include "fdsurf/hal/outputs.h"
 
 namespace fdsurf {
@@ -81,25 +82,21 @@ class ServoPen final : public hal::PenOutput {
   // Runs in the step interrupt, which the compare interrupt cannot cut
   // into (and the other way round): one byte, taken at the next pulse.
   hal::IoStatus DoSetPen(bool down) override {
-    down_ = down;
-    next_compare_ = CompareFor(down ? down_us_ : up_us_);
+    widths_.set_down(down);
+    next_compare_ = CompareFor(widths_.WidthUs());
     return hal::IoStatus::kOk;
   }
   // Also from the step interrupt (Device::Tick), before any pen change; the
   // pen moves to the new width of the state it is in. Both 0: the image's.
   hal::IoStatus DoConfigureServo(uint16_t up_us, uint16_t down_us) override {
-    const bool image_widths = up_us == 0 && down_us == 0;
-    up_us_ = image_widths ? kServoUpUs : up_us;
-    down_us_ = image_widths ? kServoDownUs : down_us;
-    return DoSetPen(down_);
+    widths_.Configure(up_us, down_us);
+    return DoSetPen(widths_.down());
   }
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
 
   volatile uint8_t next_compare_ = CompareFor(kServoUpUs);
   uint8_t phase_ = 0;
-  uint16_t up_us_ = kServoUpUs;
-  uint16_t down_us_ = kServoDownUs;
-  bool down_ = false;
+  board::ServoWidths<kServoUpUs, kServoDownUs> widths_;
 };
 
 }  // namespace uno
