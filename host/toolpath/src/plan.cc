@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
 
 #include "fdsurf/host/constructions.h"
@@ -142,33 +143,20 @@ std::vector<Stroke> RemoveDrawnTwice(const PatchSet& set, const Toolpath& path,
 
 // 2. Strokes that meet end to end become one pen-down stroke.
 std::vector<Stroke> JoinTouching(std::vector<Stroke> strokes) {
-  std::multimap<StrokePoint, std::size_t> ends;
-  for (std::size_t i = 0; i < strokes.size(); ++i) {
-    ends.emplace(strokes[i].points.front(), i);
-    ends.emplace(strokes[i].points.back(), i);
-  }
-  std::vector<bool> used(strokes.size(), false);
-  const auto unused_at = [&](const StrokePoint& point) -> std::ptrdiff_t {
-    auto [lo, hi] = ends.equal_range(point);
-    for (auto it = lo; it != hi; ++it) {
-      if (!used[it->second]) return static_cast<std::ptrdiff_t>(it->second);
-    }
-    return -1;
-  };
+  std::vector<std::array<StrokePoint, 2>> ends;
+  ends.reserve(strokes.size());
+  for (const Stroke& s : strokes) ends.push_back({s.points.front(), s.points.back()});
   std::vector<Stroke> joined;
-  for (std::size_t i = 0; i < strokes.size(); ++i) {
-    if (used[i]) continue;
-    used[i] = true;
-    Stroke chain = std::move(strokes[i]);
-    for (int side = 0; side < 2; ++side) {
-      for (std::ptrdiff_t next = unused_at(chain.points.back()); next >= 0;
-           next = unused_at(chain.points.back())) {
-        used[static_cast<std::size_t>(next)] = true;
-        Stroke& other = strokes[static_cast<std::size_t>(next)];
-        if (other.points.front() != chain.points.back()) Reverse(&other);
-        Append(&chain, other);
+  for (const std::vector<Visit>& visits : ChainTouching(ends)) {
+    Stroke chain;
+    for (const Visit& visit : visits) {
+      Stroke& piece = strokes[visit.index];
+      if (visit.reversed) Reverse(&piece);
+      if (chain.points.empty()) {
+        chain = std::move(piece);
+      } else {
+        Append(&chain, piece);
       }
-      Reverse(&chain);  // then extend the other end
     }
     chain.params.clear();  // a joined stroke spans several curves
     joined.push_back(std::move(chain));
@@ -192,52 +180,22 @@ std::vector<Stroke> JoinInSequence(std::vector<Stroke> strokes) {
   return joined;
 }
 
-// 3. Nearest neighbour from `start`, reversing where it helps.
+// 3 and 4. Nearest neighbour from `start`, reversing where it helps, then
+// 2-opt and Or-opt.
 std::vector<Stroke> OrderStrokes(std::vector<Stroke> strokes, const PlanPoint& start) {
   std::vector<std::array<PlanPoint, 2>> ends;
   ends.reserve(strokes.size());
   for (const Stroke& s : strokes)
     ends.push_back({ToPlan(s.points.front()), ToPlan(s.points.back())});
+  std::vector<Visit> order = OrderNearestNeighbour(ends, true, PlanMetric::kPlane, start);
+  ImproveOrder(ends, PlanMetric::kPlane, start, &order);
   std::vector<Stroke> ordered;
   ordered.reserve(strokes.size());
-  for (const Visit& visit : OrderNearestNeighbour(ends, true, PlanMetric::kPlane, start)) {
+  for (const Visit& visit : order) {
     if (visit.reversed) Reverse(&strokes[visit.index]);
     ordered.push_back(std::move(strokes[visit.index]));
   }
   return ordered;
-}
-
-// 4. 2-opt: reversing the run i..j (and each stroke in it) replaces the
-// links exit(i-1)→entry_of(i) and exit_of(j)→entry(j+1) by exit(i-1)→exit_of(j) and
-// entry_of(i)→entry(j+1). A window keeps large drawings fast.
-void ImproveByTwoOpt(std::vector<Stroke>* strokes, const PlanPoint& start) {
-  std::vector<Stroke>& ordered = *strokes;
-  const std::size_t n = ordered.size();
-  const auto entry_of = [&](std::size_t k) { return ToPlan(ordered[k].points.front()); };
-  const auto exit_of = [&](std::size_t k) { return ToPlan(ordered[k].points.back()); };
-  const auto exit_before = [&](std::size_t k) { return k == 0 ? start : exit_of(k - 1); };
-  constexpr std::size_t kWindow = 300;
-  constexpr int kPasses = 30;
-  for (int pass = 0; pass < kPasses; ++pass) {
-    bool improved = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      const PlanPoint before = exit_before(i);
-      for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
-        const bool last = j + 1 >= n;
-        const double old_links = PlaneDistance(before, entry_of(i)) +
-                                 (last ? 0 : PlaneDistance(exit_of(j), entry_of(j + 1)));
-        const double new_links = PlaneDistance(before, exit_of(j)) +
-                                 (last ? 0 : PlaneDistance(entry_of(i), entry_of(j + 1)));
-        if (new_links < old_links - 1e-9) {
-          std::reverse(ordered.begin() + static_cast<std::ptrdiff_t>(i),
-                       ordered.begin() + static_cast<std::ptrdiff_t>(j) + 1);
-          for (std::size_t k = i; k <= j; ++k) Reverse(&ordered[k]);
-          improved = true;
-        }
-      }
-    }
-    if (!improved) break;
-  }
 }
 
 // The strokes of each layer, layers in order (a stroke's layer below 0 counts as 0).
@@ -315,6 +273,200 @@ std::vector<Visit> OrderNearestNeighbour(const std::vector<std::array<PlanPoint,
   return order;
 }
 
+namespace {
+
+// Reverses a run of visits: drawn in the opposite order, each the other way.
+void ReverseVisits(std::vector<Visit>::iterator first, std::vector<Visit>::iterator last) {
+  std::reverse(first, last);
+  for (auto it = first; it != last; ++it) it->reversed = !it->reversed;
+}
+
+}  // namespace
+
+std::vector<std::vector<Visit>> ChainTouching(
+    const std::vector<std::array<std::array<std::int64_t, 3>, 2>>& ends) {
+  std::multimap<std::array<std::int64_t, 3>, std::size_t> at;
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    at.emplace(ends[i][0], i);
+    at.emplace(ends[i][1], i);
+  }
+  std::vector<bool> used(ends.size(), false);
+  const auto unused_at = [&](const std::array<std::int64_t, 3>& point) -> std::ptrdiff_t {
+    auto [lo, hi] = at.equal_range(point);
+    for (auto it = lo; it != hi; ++it) {
+      if (!used[it->second]) return static_cast<std::ptrdiff_t>(it->second);
+    }
+    return -1;
+  };
+  const auto exit_of = [&](const Visit& v) { return ends[v.index][v.reversed ? 0 : 1]; };
+  std::vector<std::vector<Visit>> chains;
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    if (used[i]) continue;
+    used[i] = true;
+    std::vector<Visit> chain{Visit{i, false}};
+    for (int side = 0; side < 2; ++side) {
+      for (std::ptrdiff_t next = unused_at(exit_of(chain.back())); next >= 0;
+           next = unused_at(exit_of(chain.back()))) {
+        const auto k = static_cast<std::size_t>(next);
+        used[k] = true;
+        chain.push_back(Visit{k, ends[k][0] != exit_of(chain.back())});
+      }
+      ReverseVisits(chain.begin(), chain.end());  // then extend the other end
+    }
+    chains.push_back(std::move(chain));
+  }
+  return chains;
+}
+
+void ImproveByTwoOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                     const PlanPoint& start, std::vector<Visit>* order) {
+  std::vector<Visit>& ordered = *order;
+  const std::size_t n = ordered.size();
+  const auto entry_of = [&](std::size_t k) {
+    return ends[ordered[k].index][ordered[k].reversed ? 1 : 0];
+  };
+  const auto exit_of = [&](std::size_t k) {
+    return ends[ordered[k].index][ordered[k].reversed ? 0 : 1];
+  };
+  const auto exit_before = [&](std::size_t k) { return k == 0 ? start : exit_of(k - 1); };
+  const auto distance = [&](const PlanPoint& a, const PlanPoint& b) {
+    return Distance(metric, a, b);
+  };
+  // Reversing the run i..j (and each piece in it) replaces the links
+  // exit(i-1)→entry_of(i) and exit_of(j)→entry(j+1) by exit(i-1)→exit_of(j)
+  // and entry_of(i)→entry(j+1). A window keeps large drawings fast.
+  constexpr std::size_t kWindow = 300;
+  constexpr int kPasses = 30;
+  for (int pass = 0; pass < kPasses; ++pass) {
+    bool improved = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      const PlanPoint before = exit_before(i);
+      for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
+        const bool last = j + 1 >= n;
+        const double old_links =
+            distance(before, entry_of(i)) + (last ? 0 : distance(exit_of(j), entry_of(j + 1)));
+        const double new_links =
+            distance(before, exit_of(j)) + (last ? 0 : distance(entry_of(i), entry_of(j + 1)));
+        if (new_links < old_links - 1e-9) {
+          ReverseVisits(ordered.begin() + static_cast<std::ptrdiff_t>(i),
+                        ordered.begin() + static_cast<std::ptrdiff_t>(j) + 1);
+          improved = true;
+        }
+      }
+    }
+    if (!improved) break;
+  }
+}
+
+namespace {
+
+// The travel of an order of pieces, and what moving one run of it costs.
+class OrderTravel {
+ public:
+  OrderTravel(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+              const PlanPoint& start)
+      : ends_(ends), metric_(metric), start_(start) {}
+
+  [[nodiscard]] PlanPoint Entry(const Visit& v) const { return ends_[v.index][v.reversed ? 1 : 0]; }
+  [[nodiscard]] PlanPoint Exit(const Visit& v) const { return ends_[v.index][v.reversed ? 0 : 1]; }
+  [[nodiscard]] double Between(const PlanPoint& a, const PlanPoint& b) const {
+    return Distance(metric_, a, b);
+  }
+  // The travel into o[k] from the piece before it (or the start).
+  [[nodiscard]] double Into(const std::vector<Visit>& o, std::size_t k) const {
+    return Between(k == 0 ? start_ : Exit(o[k - 1]), Entry(o[k]));
+  }
+  [[nodiscard]] const PlanPoint& start() const { return start_; }
+
+ private:
+  const std::vector<std::array<PlanPoint, 2>>& ends_;
+  PlanMetric metric_;
+  PlanPoint start_;
+};
+
+// One Or-opt move, if any shortens the travel: the run o[i..i+length) taken
+// out and put back, either way round, after another piece (or first) within
+// the window. Returns whether it moved one.
+bool MoveOneRun(const OrderTravel& t, std::size_t length, std::size_t window,
+                std::vector<Visit>* order) {
+  std::vector<Visit>& o = *order;
+  const std::size_t n = o.size();
+  for (std::size_t i = 0; i + length <= n; ++i) {
+    const std::size_t end = i + length;  // one past the run
+    const PlanPoint before = i == 0 ? t.start() : t.Exit(o[i - 1]);
+    // What taking the run out saves: its two links, less the one that
+    // closes the gap.
+    double saved = t.Between(before, t.Entry(o[i]));
+    if (end < n) saved += t.Into(o, end) - t.Between(before, t.Entry(o[end]));
+    // The order without the run: rest(j).
+    const auto rest = [&](std::size_t j) -> const Visit& { return o[j < i ? j : j + length]; };
+    const std::size_t rest_size = n - length;
+    // Put back before rest(p) (p = rest_size: last), p = i being where it was.
+    const std::size_t lo = i > window ? i - window : 0;
+    const std::size_t hi = std::min(rest_size, i + window);
+    for (std::size_t p = lo; p <= hi; ++p) {
+      if (p == i) continue;
+      const PlanPoint from = p == 0 ? t.start() : t.Exit(rest(p - 1));
+      const bool follows = p < rest_size;
+      const double old_link = follows ? t.Between(from, t.Entry(rest(p))) : 0.0;
+      for (const bool reversed : {false, true}) {
+        const PlanPoint in = reversed ? t.Exit(o[end - 1]) : t.Entry(o[i]);
+        const PlanPoint out = reversed ? t.Entry(o[i]) : t.Exit(o[end - 1]);
+        const double added =
+            t.Between(from, in) + (follows ? t.Between(out, t.Entry(rest(p))) : 0.0) - old_link;
+        if (added >= saved - 1e-9) continue;
+        std::vector<Visit> run(o.begin() + static_cast<std::ptrdiff_t>(i),
+                               o.begin() + static_cast<std::ptrdiff_t>(end));
+        if (reversed) ReverseVisits(run.begin(), run.end());
+        o.erase(o.begin() + static_cast<std::ptrdiff_t>(i),
+                o.begin() + static_cast<std::ptrdiff_t>(end));
+        o.insert(o.begin() + static_cast<std::ptrdiff_t>(p), run.begin(), run.end());
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void ImproveByOrOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                    const PlanPoint& start, std::vector<Visit>* order) {
+  const OrderTravel travel(ends, metric, start);
+  constexpr std::size_t kWindow = 300;
+  constexpr int kMoves = 100000;
+  for (int moves = 0; moves < kMoves;) {
+    bool moved = false;
+    for (std::size_t length = 1; length <= 3; ++length) {
+      while (moves < kMoves && MoveOneRun(travel, length, kWindow, order)) {
+        ++moves;
+        moved = true;
+      }
+    }
+    if (!moved) break;
+  }
+}
+
+void ImproveOrder(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                  const PlanPoint& start, std::vector<Visit>* order) {
+  // Each can undo what the other could not; a few rounds settle it.
+  constexpr int kRounds = 4;
+  const OrderTravel travel(ends, metric, start);
+  const auto total = [&] {
+    double sum = 0;
+    for (std::size_t k = 0; k < order->size(); ++k) sum += travel.Into(*order, k);
+    return sum;
+  };
+  double last = total();
+  for (int round = 0; round < kRounds; ++round) {
+    ImproveByTwoOpt(ends, metric, start, order);
+    ImproveByOrOpt(ends, metric, start, order);
+    const double now = total();
+    if (now >= last - 1e-9) break;
+    last = now;
+  }
+}
+
 PlanReport PlanStrokes(const PatchSet& set, Toolpath* path) {
   PlanReport report;
   const double q = path->quantum.value();
@@ -336,7 +488,6 @@ PlanReport PlanStrokes(const PatchSet& set, Toolpath* path) {
     } else {
       strokes = RemoveDrawnTwice(set, *path, std::move(layer), &report.duplicates_removed);
       strokes = OrderStrokes(JoinTouching(std::move(strokes)), pen);
-      ImproveByTwoOpt(&strokes, pen);
     }
     if (!strokes.empty()) pen = ToPlan(strokes.back().points.back());
     for (Stroke& s : strokes) planned.push_back(std::move(s));

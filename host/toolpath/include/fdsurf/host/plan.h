@@ -10,10 +10,13 @@
 //    origin, entering a piece at its start (patches, whose drawing order the
 //    device fixes) or at either end (strokes): OrderNearestNeighbour.
 //
-// `plot` applies both to strokes and then joins strokes that meet and
-// improves the order by 2-opt (PlanStrokes); `stream` applies both to
-// patches, sending the edge lines drawn already as PATCH skip_lines
-// (stream.h).
+//  - Which pieces meet end to end and are drawn as one stroke
+//    (ChainTouching), and a better order by 2-opt (ImproveByTwoOpt).
+//
+// `plot` applies all of them to strokes (PlanStrokes); `stream` to the lines
+// the device draws of each patch (stream.h, StreamPlan::kLines), or, for
+// the patches plan, the first two to whole patches, sending the edge lines
+// drawn already as PATCH skip_lines.
 #pragma once
 
 #include <array>
@@ -77,6 +80,34 @@ struct Visit {
 std::vector<Visit> OrderNearestNeighbour(const std::vector<std::array<PlanPoint, 2>>& ends,
                                          bool may_reverse, PlanMetric metric,
                                          const PlanPoint& start = {0, 0, 0});
+
+/// Chains of pieces that meet end to end, the ends compared exactly
+/// (ends[i] = {start, end} of piece i, in whole quanta or steps). Every piece
+/// is in one chain; a chain lists its pieces in drawing order, each entered
+/// at its end where `reversed`. Chains start at the pieces in index order and
+/// grow at their end, then at their start, taking the lowest-indexed piece
+/// that meets them (a piece that meets at both ends closes a loop).
+std::vector<std::vector<Visit>> ChainTouching(
+    const std::vector<std::array<std::array<std::int64_t, 3>, 2>>& ends);
+
+/// Improves an order of pieces (`order`, as OrderNearestNeighbour gives it
+/// for the same `ends`) by 2-opt: reverses a run of pieces, each drawn the
+/// other way, wherever that shortens the travel from `start` through the
+/// order, until no such run is left (at most 30 passes; runs of up to 300
+/// pieces, which keeps large drawings fast).
+void ImproveByTwoOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                     const PlanPoint& start, std::vector<Visit>* order);
+
+/// Improves an order by Or-opt: takes a run of one, two or three pieces
+/// out and puts it back elsewhere (within 300 pieces), either way round,
+/// wherever that shortens the travel, until no such move is left.
+void ImproveByOrOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                    const PlanPoint& start, std::vector<Visit>* order);
+
+/// 2-opt and Or-opt in turn until neither shortens the travel (at most four
+/// rounds): what plot and stream do to the nearest-neighbour order.
+void ImproveOrder(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+                  const PlanPoint& start, std::vector<Visit>* order);
 
 struct PlanReport {
   std::size_t strokes_before = 0;
