@@ -151,7 +151,7 @@ StreamOptions WithSchedule(const StreamOptions& o, const StreamJob& job) {
 // with --dry-run, to the simulated plotter only).
 int StreamJobTo(const StreamOptions& o, const PatchSet& set, const ToolpathOptions& drawing,
                 const MachineOptions& machine) {
-  StreamJob job = BuildStreamJob(set, drawing, machine, o.units);
+  StreamJob job = BuildStreamJob(set, drawing, machine, o.units, *ParseStreamPlan(o.plan));
   if (o.prepare_on_host) PrepareOnHost(&job);
   try {
     if (o.dry_run) return RunDryRun(o, job);
@@ -324,6 +324,13 @@ void AddStreamOptions(CLI::App* command, StreamOptions* o) {
       ->add_option("--hidden", o->hidden,
                    "show (every line) or remove (only the visible pieces, streamed as curves)")
       ->check(CLI::IsMember({"show", "remove"}));
+  command
+      ->add_option("--plan", o->plan,
+                   "lines: every line a curve, planned across patches as plot plans its strokes "
+                   "(fewest pen lifts and least pen-up travel); patches: one PATCH per patch, "
+                   "its lines in the device's order (fewest bytes on the wire)")
+      ->check(CLI::IsMember({"lines", "patches"}))
+      ->capture_default_str();
   command->add_flag("-q,--quiet", o->quiet, "no summary or progress on stderr");
   command->add_flag("--dry-run", o->dry_run,
                     "run the job through the simulated plotter with these limits and report "

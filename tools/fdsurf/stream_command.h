@@ -91,6 +91,9 @@ struct StreamOptions {
   /// --hidden: "show", or "remove": only the visible pieces of the lines,
   /// streamed as Bézier curves (VisibleCurvesOf, stream.h).
   std::string hidden = "show";
+  /// --plan: "lines" (each line a curve, planned as plot plans strokes) or
+  /// "patches" (one PATCH per patch); StreamPlan, fdsurf/host/stream.h.
+  std::string plan = "lines";
   /// Do not wait for Enter between layers (the pen change); the runners
   /// also go on without waiting when stdin is not a terminal.
   bool no_pause = false;

@@ -18,6 +18,7 @@
 #include "fdsurf/host/text.h"
 #include "fdsurf/motion/path_generator.h"
 #include "fdsurf/protocol/codec.h"
+#include "stream_internal.h"
 
 namespace fdsurf::host {
 namespace {
@@ -314,64 +315,26 @@ std::vector<CurveVisit> OrderLayer(const std::vector<std::size_t>& curves,
   return order;
 }
 
-// Appends PEN, MOVE and CURVE commands to the job, tracking the pen.
-class CurveEmitter {
- public:
-  explicit CurveEmitter(StreamJob* job) : job_(job) {}
-
-  void Pen(bool down) {
-    if (down == pen_down_) return;
-    protocol::Command command;
-    command.type = protocol::MessageType::kPen;
-    command.seq = 0;
-    command.body.pen.down = down;
-    job_->commands.push_back(command);
-    job_->labels.emplace_back(down ? "pen down" : "pen up");
-    pen_down_ = down;
-  }
-
-  void Move(const std::array<std::int32_t, 3>& target, std::string label) {
-    protocol::Command move;
-    move.type = protocol::MessageType::kMove;
-    move.seq = 0;
+// A curve of the file through `emit`. A straight curve is one MOVE with the
+// pen down: the device draws the straight line from where it is (the
+// curve's rounded start) to the same rounded end point that the CURVE would
+// end at.
+void DrawCurve(const DeviceCurve& curve, bool straight, std::size_t index,
+               const std::string& origin, CurveEmitter* emit, StreamJob* job) {
+  const std::string name = std::to_string(index) + " (" + origin + ")";
+  if (straight) {
+    protocol::Command line;
+    line.type = protocol::MessageType::kMove;
+    line.seq = 0;
     for (int a = 0; a < protocol::kMaxAxes; ++a) {
-      move.body.move.target[a] = target[static_cast<std::size_t>(a)];
+      line.body.move.target[a] = curve.end[static_cast<std::size_t>(a)];
     }
-    job_->commands.push_back(move);
-    job_->labels.push_back(std::move(label));
+    emit->Draw(line, curve.start, curve.end, "line " + name);
+  } else {
+    emit->Draw(curve.command, curve.start, curve.end, "curve " + name);
   }
-
-  // A straight curve is one MOVE with the pen down: the device draws the
-  // straight line from where it is (the curve's rounded start) to the same
-  // rounded end point that the CURVE would end at.
-  void Draw(const DeviceCurve& curve, bool straight, std::size_t index, const std::string& origin) {
-    const std::string name = std::to_string(index) + " (" + origin + ")";
-    if (!placed_ || curve.start != at_) {
-      Pen(false);
-      Move(curve.start, "travel to curve " + name);
-    }
-    Pen(true);
-    if (straight) {
-      Move(curve.end, "line " + name);
-    } else {
-      job_->commands.push_back(curve.command);
-      job_->labels.push_back("curve " + name);
-    }
-    job_->curves.push_back(index);
-    at_ = curve.end;
-    placed_ = true;
-  }
-
-  [[nodiscard]] PlanPoint At() const {
-    return {static_cast<double>(at_[0]), static_cast<double>(at_[1]), static_cast<double>(at_[2])};
-  }
-
- private:
-  StreamJob* job_;
-  bool pen_down_ = false;
-  bool placed_ = false;
-  std::array<std::int32_t, 3> at_{};
-};
+  job->curves.push_back(index);
+}
 
 // The file's curves, layer by layer in layer order (each layer's start
 // recorded in job->layers when the file has layers), within a layer in the
@@ -398,8 +361,9 @@ void AddCurveCommands(const PatchSet& set, const ToolpathOptions& t, StreamJob* 
     for (const CurveVisit& visit :
          OrderLayer(curves, device, set.keep_order, reversible, emit.At())) {
       const Curve& curve = set.curves[visit.curve];
-      emit.Draw(visit.reversed ? ToDevice(Reversed(curve), t, *job) : device[visit.curve],
-                curve.straight, visit.curve, curve.origin);
+      const DeviceCurve drawn =
+          visit.reversed ? ToDevice(Reversed(curve), t, *job) : device[visit.curve];
+      DrawCurve(drawn, curve.straight, visit.curve, curve.origin, &emit, job);
     }
   }
   emit.Pen(false);
@@ -556,6 +520,12 @@ protocol::MachineConfig MachineConfigFor(const MachineOptions& machine, int dims
   return ConfigFor(machine, travel, units);
 }
 
+std::optional<StreamPlan> ParseStreamPlan(const std::string& text) {
+  if (text == "lines") return StreamPlan::kLines;
+  if (text == "patches") return StreamPlan::kPatches;
+  return std::nullopt;
+}
+
 std::optional<MachineOrigin> ParseMachineOrigin(const std::string& text) {
   if (text == "bottom-left") return MachineOrigin::kBottomLeft;
   if (text == "top-left") return MachineOrigin::kTopLeft;
@@ -618,7 +588,7 @@ std::array<std::int64_t, 3> PageSteps(const StreamJob& job, std::array<std::int6
 }
 
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
-                         const MachineOptions& machine, const std::string& units) {
+                         const MachineOptions& machine, const std::string& units, StreamPlan plan) {
   ToolpathOptions t = options;
   t.quantum = machine.step;
   StreamJob job;
@@ -641,17 +611,31 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   job.commands.push_back(configure);
   job.labels.emplace_back("the machine configuration");
 
-  // The patches, nearest neighbour first from the origin; the device fixes
-  // the order of the lines inside a patch, so a patch is never reversed.
-  std::vector<std::array<PlanPoint, 2>> ends;
-  ends.reserve(set.patches.size());
-  for (const Patch& patch : set.patches) ends.push_back(Ends(patch, job, t.lines_s, t.lines_t));
+  // Edge lines that an earlier patch (in file order) draws are left out of
+  // the later one (PATCH skip_lines), whichever plan sends them.
   DrawnCurves drawn_edges;
-  for (const Visit& visit : OrderNearestNeighbour(ends, false, PlanMetric::kSpace)) {
-    const Patch& patch = set.patches[visit.index];
-    job.commands.push_back(PatchCommandFor(patch, t, machine, &job, &drawn_edges));
-    job.labels.push_back("patch " + std::to_string(visit.index) + " (" + patch.origin + ")");
-    job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
+  if (plan == StreamPlan::kLines) {
+    std::vector<protocol::Command> patches;
+    std::vector<std::string> labels;
+    for (std::size_t p = 0; p < set.patches.size(); ++p) {
+      const Patch& patch = set.patches[p];
+      patches.push_back(PatchCommandFor(patch, t, machine, &job, &drawn_edges));
+      labels.push_back("patch " + std::to_string(p) + " (" + patch.origin + ")");
+      job.patches.push_back(StreamedPatch{p, t.lines_s, t.lines_t});
+    }
+    AddPlannedLines(patches, labels, t.dims, &job);
+  } else {
+    // The patches, nearest neighbour first from the origin; the device fixes
+    // the order of the lines inside a patch, so a patch is never reversed.
+    std::vector<std::array<PlanPoint, 2>> ends;
+    ends.reserve(set.patches.size());
+    for (const Patch& patch : set.patches) ends.push_back(Ends(patch, job, t.lines_s, t.lines_t));
+    for (const Visit& visit : OrderNearestNeighbour(ends, false, PlanMetric::kSpace)) {
+      const Patch& patch = set.patches[visit.index];
+      job.commands.push_back(PatchCommandFor(patch, t, machine, &job, &drawn_edges));
+      job.labels.push_back("patch " + std::to_string(visit.index) + " (" + patch.origin + ")");
+      job.patches.push_back(StreamedPatch{visit.index, t.lines_s, t.lines_t});
+    }
   }
   AddCurveCommands(set, t, &job);
   if (t.dims == 3) {

@@ -104,8 +104,9 @@ struct LayerStart {
 
 struct StreamJob {
   protocol::MachineConfig config{};
-  /// CONFIG first, then one PATCH per patch, in drawing order, then the
-  /// file's curves (PEN, MOVE and CURVE commands; a straight curve is one
+  /// CONFIG first, then the patches (StreamPlan: one PATCH per patch, in
+  /// drawing order, or their lines as PEN, MOVE and CURVE commands), then
+  /// the file's curves (PEN, MOVE and CURVE commands; a straight curve is one
   /// MOVE with the pen down). The curves go layer by layer; within a layer
   /// in file order when PatchSet::keep_order, else chains of curves that
   /// meet end to end are ordered by nearest neighbour (Bézier and Hermite
@@ -161,13 +162,32 @@ Quantum PageQuantum(const StreamJob& job);
 std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
                                          const std::array<std::int64_t, 3>& machine);
 
+/// How a job's patches travel to the device and in what order their lines
+/// are drawn. Either way every line is the one the device's walker forms
+/// for the patch (motion::ForEachDrawnLine), stepped the same, and an edge
+/// line that an earlier patch (in file order) draws is left out.
+enum class StreamPlan {
+  /// Each drawn line as a CURVE, power basis, with the walker's
+  /// coefficients, planned across patches as `fdsurf plot` plans its
+  /// strokes (plan.h): lines that meet end to end are one pen-down stroke,
+  /// across patch edges too; strokes in nearest-neighbour order improved by
+  /// 2-opt, either direction. As few pen lifts and as little pen-up travel
+  /// as plot's plan of the same drawing; more bytes on the wire.
+  kLines,
+  /// One PATCH per patch, the patches in nearest-neighbour order; the
+  /// device draws a patch's lines in its own order (s-lines, then t-lines,
+  /// serpentine) and lifts the pen between lines that do not meet and at
+  /// the end of every patch. The fewest bytes on the wire.
+  kPatches,
+};
+
+/// "lines", "patches": the plan; nullopt for another text.
+std::optional<StreamPlan> ParseStreamPlan(const std::string& text);
+
 /// Builds the job. `options` as for `fdsurf plot` (lines, view, fit, margin,
-/// tolerance, dims; the quantum is replaced by machine.step). The plan
-/// (plan.h) orders the patches by nearest neighbour so that travel between
-/// them stays short, and leaves out edge lines that an earlier patch draws
-/// already (patches of a surface share their edges: the teapot's 32 patches
-/// share 52). Throws OptionError ("lines", "tolerance", "fit", "travel X",
-/// "travel Y", "travel Z", "speed", "accel", "pen delay"; a travel over
+/// tolerance, dims; the quantum is replaced by machine.step); the patches
+/// as `plan` says, then the file's curves. Throws OptionError ("lines", "tolerance", "fit", "travel
+/// X", "travel Y", "travel Z", "speed", "accel", "pen delay"; a travel over
 /// motion::kMaxPlannableTravelSteps, which the device refuses), InputError
 /// (a file with nothing to draw) and EngineError (a patch out of range).
 /// Before returning, every command is put through the device's own
@@ -176,7 +196,8 @@ std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
 /// one that would be throws EngineError naming the command and its exact
 /// range in `units`.
 StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
-                         const MachineOptions& machine, const std::string& units);
+                         const MachineOptions& machine, const std::string& units,
+                         StreamPlan plan = StreamPlan::kLines);
 
 /// `fdsurf stream --prepare-on-host`: the job with every PATCH and CURVE
 /// replaced by what the device draws for it, planned here ("the host
