@@ -36,7 +36,10 @@ using fdsurf::test_support::SecondsSince;
 using fdsurf::test_support::Slurp;
 using fdsurf::test_support::WaitForExit;
 
-const std::string kJob = std::string("'") + FDSURF_EXAMPLES_DIR + "/bezier-bump.json' --lines 3";
+// One PATCH per patch (`--plan patches`): the link's tests count the job's
+// commands as CONFIG and the 4 patches.
+const std::string kJob =
+    std::string("'") + FDSURF_EXAMPLES_DIR + "/bezier-bump.json' --lines 3 --plan patches";
 
 struct Result {
   int exit_code;
