@@ -325,16 +325,17 @@ def relay_options(args):
     return []
 
 
-def stream_timeout_s(duration_s):
-    """How long the serial run may take: 4 x the machine time, plus connecting."""
-    return int(duration_s * 4 + 90)
+def stream_timeout_s(duration_s, factor=4):
+    """How long the serial run may take: `factor` x the machine time (4 by
+    default), plus connecting."""
+    return int(duration_s * factor + 90)
 
 
 def stream(args, processes, board, link, duration_s):
     """The real host tool over the serial line; STOP mid-job for `stop`."""
     command = [args.fdsurf, "stream", args.job, "--device",
                "serial:%s:%d" % (link, board["baud"]), "-q"] + args.job_args
-    timeout_s = stream_timeout_s(duration_s)
+    timeout_s = stream_timeout_s(duration_s, args.stream_time_factor)
     if args.scenario != "stop":
         code = run_logged(processes, "fdsurf", command, timeout_s)
         if code != 0:
@@ -533,7 +534,7 @@ def run(args, processes):
     time.sleep(args.settle_s)
     tick_hz = probe_tick_hz(args, processes, link, board["baud"])
     duration_s = reference(args, processes, tick_hz, ref)
-    needed_s = stream_timeout_s(duration_s) + 30
+    needed_s = stream_timeout_s(duration_s, args.stream_time_factor) + 30
     if needed_s > args.time_limit_s:
         raise Failure("the job takes %.0f s of machine time: the harness needs --time-limit-s "
                       "%d or more, not %d" % (duration_s, needed_s, args.time_limit_s))
@@ -580,7 +581,11 @@ def parse():
                         choices=SCENARIOS)
     parser.add_argument("--time-limit-s", type=int, default=240,
                         help="the harness's own time limit, should this driver die (default "
-                             "240 s; a job needs 4 x its machine time + 120 s)")
+                             "240 s; a job needs --stream-time-factor x its machine time + 120 s)")
+    parser.add_argument("--stream-time-factor", type=float, default=4,
+                        help="the host tool may take this many times the simulated plotter's "
+                             "machine time (default 4; a CPU-bound board on a whole teapot, or "
+                             "several emulators on one machine, need more)")
     parser.add_argument("--disturb-after", type=int, default=600,
                         help="hangup/corrupt: bytes towards the board before it happens")
     parser.add_argument("--stop-after-s", type=float, help="stop: seconds before the SIGINT")
