@@ -31,7 +31,8 @@ const host::PatchSet& Teapot() {
 // 3×3 lines a patch, 0.0125 mm steps, 250 mm/s.
 host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250,
                                host::MachineOrigin origin = host::MachineOrigin::kBottomLeft,
-                               const char* y_step = nullptr) {
+                               const char* y_step = nullptr,
+                               host::StreamPlan plan = host::StreamPlan::kLines) {
   host::ToolpathOptions options;
   options.view = *host::NamedView("iso");
   options.fit = std::array<double, 2>{24, 18};
@@ -46,7 +47,7 @@ host::StreamJob SmallTeapotJob(double accel = 5000, double speed = 250,
   machine.pen_delay_ms = 5;
   machine.origin = origin;
   if (y_step != nullptr) machine.own_step[1] = host::Quantum::Parse(y_step);
-  return host::BuildStreamJob(Teapot(), options, machine, "mm");
+  return host::BuildStreamJob(Teapot(), options, machine, "mm", plan);
 }
 
 struct Streamed {
@@ -420,21 +421,9 @@ TEST(SimulatedPlotter, DrawsTheSameWhenTheHostPlansTheLines) {
 // does, in fewer pen-down strokes and less machine time, within the
 // tolerance and the limits.
 TEST(SimulatedPlotter, TheLinesPlanDrawsAsCloseInFewerStrokesAndLessTime) {
-  host::ToolpathOptions options;
-  options.view = *host::NamedView("iso");
-  options.fit = std::array<double, 2>{24, 18};
-  options.margin = 1;
-  options.lines_s = 3;
-  options.lines_t = 3;
-  options.tolerance = 0.02;
-  host::MachineOptions machine;
-  machine.speed = 250;
-  machine.accel = 5000;
-  machine.pen_delay_ms = 5;
-  const host::StreamJob lines =
-      host::BuildStreamJob(Teapot(), options, machine, "mm", host::StreamPlan::kLines);
-  const host::StreamJob patches =
-      host::BuildStreamJob(Teapot(), options, machine, "mm", host::StreamPlan::kPatches);
+  const host::StreamJob lines = SmallTeapotJob();
+  const host::StreamJob patches = SmallTeapotJob(5000, 250, host::MachineOrigin::kBottomLeft,
+                                                 nullptr, host::StreamPlan::kPatches);
   const Streamed by_lines = Stream(lines, PlotterOptions{});
   const Streamed by_patches = Stream(patches, PlotterOptions{});
   ASSERT_TRUE(by_lines.result.finished) << by_lines.result.error;
