@@ -611,8 +611,9 @@ StreamJob BuildStreamJob(const PatchSet& set, const ToolpathOptions& options,
   job.commands.push_back(configure);
   job.labels.emplace_back("the machine configuration");
 
-  // Edge lines that an earlier patch (in file order) draws are left out of
-  // the later one (PATCH skip_lines), whichever plan sends them.
+  // An edge line that a patch before it draws is left out of a patch (PATCH
+  // skip_lines): before it in file order for the lines plan (plot's order
+  // before planning), in drawing order for the patches plan.
   DrawnCurves drawn_edges;
   if (plan == StreamPlan::kLines) {
     std::vector<protocol::Command> patches;

@@ -165,7 +165,7 @@ std::array<std::int64_t, 3> PagePosition(const StreamJob& job,
 /// How a job's patches travel to the device and in what order their lines
 /// are drawn. Either way every line is the one the device's walker forms
 /// for the patch (motion::ForEachDrawnLine), stepped the same, and an edge
-/// line that an earlier patch (in file order) draws is left out.
+/// line that a patch before it draws is left out (DrawnCurves).
 enum class StreamPlan {
   /// Each drawn line as a CURVE, power basis, with the walker's
   /// coefficients, planned across patches as `fdsurf plot` plans its
