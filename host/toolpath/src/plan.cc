@@ -281,6 +281,30 @@ void ReverseVisits(std::vector<Visit>::iterator first, std::vector<Visit>::itera
   for (auto it = first; it != last; ++it) it->reversed = !it->reversed;
 }
 
+// The travel of an order of pieces, and what moving one run of it costs.
+class OrderTravel {
+ public:
+  OrderTravel(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
+              const PlanPoint& start)
+      : ends_(ends), metric_(metric), start_(start) {}
+
+  [[nodiscard]] PlanPoint Entry(const Visit& v) const { return ends_[v.index][v.reversed ? 1 : 0]; }
+  [[nodiscard]] PlanPoint Exit(const Visit& v) const { return ends_[v.index][v.reversed ? 0 : 1]; }
+  [[nodiscard]] double Between(const PlanPoint& a, const PlanPoint& b) const {
+    return Distance(metric_, a, b);
+  }
+  // The travel into o[k] from the piece before it (or the start).
+  [[nodiscard]] double Into(const std::vector<Visit>& o, std::size_t k) const {
+    return Between(k == 0 ? start_ : Exit(o[k - 1]), Entry(o[k]));
+  }
+  [[nodiscard]] const PlanPoint& start() const { return start_; }
+
+ private:
+  const std::vector<std::array<PlanPoint, 2>>& ends_;
+  PlanMetric metric_;
+  PlanPoint start_;
+};
+
 }  // namespace
 
 std::vector<std::vector<Visit>> ChainTouching(
@@ -320,18 +344,12 @@ std::vector<std::vector<Visit>> ChainTouching(
 
 void ImproveByTwoOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
                      const PlanPoint& start, std::vector<Visit>* order) {
+  const OrderTravel t(ends, metric, start);
   std::vector<Visit>& ordered = *order;
   const std::size_t n = ordered.size();
-  const auto entry_of = [&](std::size_t k) {
-    return ends[ordered[k].index][ordered[k].reversed ? 1 : 0];
-  };
-  const auto exit_of = [&](std::size_t k) {
-    return ends[ordered[k].index][ordered[k].reversed ? 0 : 1];
-  };
-  const auto exit_before = [&](std::size_t k) { return k == 0 ? start : exit_of(k - 1); };
-  const auto distance = [&](const PlanPoint& a, const PlanPoint& b) {
-    return Distance(metric, a, b);
-  };
+  const auto entry_of = [&](std::size_t k) { return t.Entry(ordered[k]); };
+  const auto exit_of = [&](std::size_t k) { return t.Exit(ordered[k]); };
+  const auto distance = [&](const PlanPoint& a, const PlanPoint& b) { return t.Between(a, b); };
   // Reversing the run i..j (and each piece in it) replaces the links
   // exit(i-1)→entry_of(i) and exit_of(j)→entry(j+1) by exit(i-1)→exit_of(j)
   // and entry_of(i)→entry(j+1). A window keeps large drawings fast.
@@ -340,7 +358,7 @@ void ImproveByTwoOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetr
   for (int pass = 0; pass < kPasses; ++pass) {
     bool improved = false;
     for (std::size_t i = 0; i < n; ++i) {
-      const PlanPoint before = exit_before(i);
+      const PlanPoint before = i == 0 ? start : exit_of(i - 1);
       for (std::size_t j = i + 1; j < n && j < i + kWindow; ++j) {
         const bool last = j + 1 >= n;
         const double old_links =
@@ -359,30 +377,6 @@ void ImproveByTwoOpt(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetr
 }
 
 namespace {
-
-// The travel of an order of pieces, and what moving one run of it costs.
-class OrderTravel {
- public:
-  OrderTravel(const std::vector<std::array<PlanPoint, 2>>& ends, PlanMetric metric,
-              const PlanPoint& start)
-      : ends_(ends), metric_(metric), start_(start) {}
-
-  [[nodiscard]] PlanPoint Entry(const Visit& v) const { return ends_[v.index][v.reversed ? 1 : 0]; }
-  [[nodiscard]] PlanPoint Exit(const Visit& v) const { return ends_[v.index][v.reversed ? 0 : 1]; }
-  [[nodiscard]] double Between(const PlanPoint& a, const PlanPoint& b) const {
-    return Distance(metric_, a, b);
-  }
-  // The travel into o[k] from the piece before it (or the start).
-  [[nodiscard]] double Into(const std::vector<Visit>& o, std::size_t k) const {
-    return Between(k == 0 ? start_ : Exit(o[k - 1]), Entry(o[k]));
-  }
-  [[nodiscard]] const PlanPoint& start() const { return start_; }
-
- private:
-  const std::vector<std::array<PlanPoint, 2>>& ends_;
-  PlanMetric metric_;
-  PlanPoint start_;
-};
 
 // One Or-opt move, if any shortens the travel: the run o[i..i+length) taken
 // out and put back, either way round, after another piece (or first) within
