@@ -7,6 +7,7 @@
 //                       [--board mega2560-ramps|uno-cnc-shield]
 //                       [--time-limit-s N] [--measures OUT.tsv] [--speed realtime|max]
 //                       [--endstop-start X,Y[,Z]] [--endstop-triggered-level 1|0]
+//                       [--profile OUT.tsv]
 //
 // USART0 is bridged to a Unix-domain stream socket at PATH (one client at a
 // time; the next is accepted when it leaves). Received bytes enter simavr's
@@ -28,6 +29,10 @@
 // (X_MAX D2 = PE4, Y_MAX D15 = PJ0, Z_MAX D19 = PD2) are always held
 // released (the Uno has none). Each switch change and the carriage's final
 // position go to stderr ("carriage ...").
+// With --profile: the emulated cycles spent at each instruction address
+// (flash byte address, hex; a row "asleep" for the core asleep), interrupts
+// included, as a TSV for
+// profile_report.py to sum per function (docs/performance.md).
 // Exits 0 on SIGTERM/SIGINT or at the time limit, having flushed OUT.
 #include <avr_ioport.h>
 #include <avr_uart.h>
@@ -72,6 +77,7 @@ struct Options {
   std::string socket_path;
   std::string waveform;
   std::string measures;
+  std::string profile;
   double time_limit_s = 0;  // 0: none
   bool realtime = true;
   std::vector<long> endstop_start;  // steps above each min switch; empty: no carriage
@@ -84,7 +90,7 @@ struct Options {
                "--uart-socket PATH --waveform OUT [--board NAME] [--time-limit-s N] "
                "[--measures OUT.tsv] "
                "[--speed realtime|max] [--endstop-start X,Y[,Z]] "
-               "[--endstop-triggered-level 1|0]\n",
+               "[--endstop-triggered-level 1|0] [--profile OUT.tsv]\n",
                why.c_str());
   std::exit(2);
 }
@@ -128,6 +134,8 @@ Options ParseOptions(int argc, char** argv) {
       o.waveform = value;
     } else if (arg == "--measures") {
       o.measures = value;
+    } else if (arg == "--profile") {
+      o.profile = value;
     } else if (arg == "--time-limit-s") {
       char* end = nullptr;
       o.time_limit_s = std::strtod(value.c_str(), &end);
@@ -410,8 +418,38 @@ std::uint64_t NowNs() {
                                         .count());
 }
 
+// Cycles per instruction word, for --profile.
+class Profile {
+ public:
+  void Add(avr_flashaddr_t pc, bool asleep, std::uint64_t cycles) {
+    if (asleep) {
+      asleep_ += cycles;
+      return;
+    }
+    const std::size_t word = pc / 2;
+    if (word >= cycles_.size()) cycles_.resize(word + 1, 0);
+    cycles_[word] += cycles;
+  }
+  [[nodiscard]] bool Write(const std::string& path) const {
+    FILE* file = std::fopen(path.c_str(), "w");
+    if (file == nullptr) return false;
+    std::fputs("address\tcycles\n", file);
+    std::fprintf(file, "asleep\t%llu\n", static_cast<unsigned long long>(asleep_));
+    for (std::size_t word = 0; word < cycles_.size(); ++word) {
+      if (cycles_[word] == 0) continue;
+      std::fprintf(file, "%zx\t%llu\n", word * 2, static_cast<unsigned long long>(cycles_[word]));
+    }
+    return std::fclose(file) == 0;
+  }
+
+ private:
+  std::vector<std::uint64_t> cycles_;
+  std::uint64_t asleep_ = 0;
+};
+
 // Runs until a signal, the time limit or a crash; true unless it crashed.
-bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge, Carriage* carriage) {
+bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge, Carriage* carriage,
+             Profile* profile) {
   avr_t* avr = emulator->avr;
   const std::uint64_t limit =
       o.time_limit_s > 0 ? static_cast<std::uint64_t>(o.time_limit_s * kCpuHz) : UINT64_MAX;
@@ -419,7 +457,11 @@ bool RunLoop(const Options& o, Emulator* emulator, UartBridge* bridge, Carriage*
   while (g_stop == 0 && avr->cycle < limit) {
     const std::uint64_t slice_end = avr->cycle + kSliceCycles;
     while (avr->cycle < slice_end) {
+      const avr_flashaddr_t pc = avr->pc;
+      const bool asleep = avr->state == cpu_Sleeping;
+      const std::uint64_t before = avr->cycle;
       const int state = avr_run(avr);
+      if (profile != nullptr) profile->Add(pc, asleep, avr->cycle - before);
       if (state == cpu_Done || state == cpu_Crashed) {
         std::fprintf(stderr, "fdsurf_simavr_board: the core stopped (%s) at cycle %llu\n",
                      state == cpu_Crashed ? "crashed" : "done",
@@ -471,7 +513,12 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   std::fputs("ready\n", out);
   std::fflush(out);
-  const bool ok = RunLoop(o, &emulator, &bridge, &carriage);
+  Profile profile;
+  const bool ok = RunLoop(o, &emulator, &bridge, &carriage, o.profile.empty() ? nullptr : &profile);
+  if (!o.profile.empty() && !profile.Write(o.profile)) {
+    std::fprintf(stderr, "fdsurf_simavr_board: --profile %s: cannot write it\n", o.profile.c_str());
+    return 2;
+  }
   bridge.Close();
   if (!o.endstop_start.empty()) carriage.Report();
   recorder.Finish(emulator.avr);
