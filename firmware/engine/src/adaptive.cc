@@ -29,6 +29,21 @@ int64_t ChordBudget16(uint32_t tolerance_q8, int dims) {
          kPreStepAllowance16;
 }
 
+}  // namespace
+
+int ChordBudgetBits(uint32_t tolerance_q8, int dims) {
+  // In 2^-16 quanta: what the tolerance leaves per axis after the rounding
+  // of the points and the errors before stepping (ChordBudget16), less the
+  // 2^-8 of a chord end's fine value.
+  const int64_t room = ChordBudget16(tolerance_q8, dims) - (int64_t{1} << 8);
+  for (int bits = kLargestChordBudgetBits; bits <= kSmallestChordBudgetBits; ++bits) {
+    if ((int64_t{1} << (16 - bits)) <= room) return bits;
+  }
+  return kFinestStepsOnly;
+}
+
+namespace {
+
 // round(x / (a·b)), halves away from zero, for |x| < 2^125 and a, b ≥ 1:
 // floor((2|x| + ab) / 2ab) by successive floor divisions, which compose.
 int64_t RoundedQuotient(const internal::WideInt<4>& x, uint32_t a, uint32_t b) {

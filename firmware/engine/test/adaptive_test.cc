@@ -483,6 +483,150 @@ TEST(AdaptiveCurve, ALevelChosenElsewhereIsRefusedOutsideItsRange) {
 
 // Walker coefficients against the exact rational line: for an s-line at
 // s = i/n, coefficient l of t^(3-l) is Σ_r Σ_c w_s[r]·g[r][c]·(dM)[l][c] / (d²n³).
+// floor(n / d) for d > 0.
+I128 FloorDivide(I128 n, I128 d) {
+  const I128 q = n / d;
+  return (n % d != 0 && n < 0) ? q - 1 : q;
+}
+
+// floor((x + 1/2)·2^8) of the prepared (rounded-coefficient) curve at
+// position/2^L, exactly: the chord cursor's point before it wraps.
+I128 ExactFine(const PowerCurve1& raw, std::uint32_t position, int level) {
+  const I128 p = position;
+  const I128 num = raw.c[0] * p * p * p + (raw.c[1] * p * p << level) +
+                   (raw.c[2] * p << (2 * level)) + (I128(raw.c[3]) << (3 * level));
+  const I128 den = I128(1) << (3 * level + 16);
+  return FloorDivide(num * 256 + den * 128, den);
+}
+
+long double ExactValue(const PowerCurve1& raw, long double t) {
+  return (((raw.c[0] * t + raw.c[1]) * t + raw.c[2]) * t + raw.c[3]) / kOneQuantumRaw;
+}
+
+struct Chord {
+  std::uint32_t position;
+  std::array<std::int32_t, 3> fine;
+  bool finest;
+};
+
+template <typename Acc>
+std::vector<Chord> ChordsOf(const PreparedAdaptiveCurve<3>& curve, int budget_bits) {
+  AdaptiveChordCursor<Acc, 3> cursor;
+  cursor.Reset(curve, budget_bits);
+  std::vector<Chord> out;
+  std::int32_t fine[3];
+  bool finest = false;
+  while (cursor.Next(fine, &finest))
+    out.push_back({cursor.position(), {fine[0], fine[1], fine[2]}, finest});
+  return out;
+}
+
+// The chord cursor on step-exact tables (what the device steps), checked
+// against the exact rounded-coefficient curve: every end is its exact fine
+// value (mod 2^32), every chord that is not one finest step is within its
+// budget (2^-6, 2^-9 or 2^-13 quanta per axis) of the curve at the same
+// parameter (sampled), a finest step moves at most one quantum, no chord
+// more than 2^8; with kFinestStepsOnly every chord is one finest step; both
+// accumulators give the same chords.
+TEST(AdaptiveChordCursor, EndsAreExactAndChordsWithinTheirBudget) {
+  std::mt19937_64 rng(20261207);
+  const double tolerances[] = {1.0, 2.5, 10.0};
+  const int budgets[] = {6, 9, 13, kFinestStepsOnly};
+  int long_chords = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int budget_bits = budgets[trial % 4];
+    const double range = std::ldexp(1.0, trial % 17);  // 1 to 2^16 quanta
+    const DoubleCubic cubic = RandomCubic(rng, range);
+    PowerCurve1 raw[3];
+    ToRaw(cubic, raw);
+    AdaptiveSettings settings;
+    settings.mode = AdaptiveMode::kStepExact;
+    settings.tolerance_q8 = static_cast<std::uint32_t>(tolerances[trial % 3] * 256);
+    PreparedAdaptiveCurve<3> curve;
+    ASSERT_EQ(PrepareAdaptiveCurve(raw, settings, &curve), Status::kOk) << trial;
+    const int level = curve.finest_level;
+    const std::vector<Chord> chords = curve.format.acc_bits == 64
+                                          ? ChordsOf<std::int64_t>(curve, budget_bits)
+                                          : ChordsOf<Int128>(curve, budget_bits);
+    if (curve.format.acc_bits == 64) {
+      const std::vector<Chord> wide = ChordsOf<Int128>(curve, budget_bits);
+      ASSERT_EQ(wide.size(), chords.size()) << trial;
+      for (std::size_t k = 0; k < chords.size(); ++k) ASSERT_EQ(wide[k].fine, chords[k].fine);
+    }
+    ASSERT_GE(chords.size(), 2u);
+    EXPECT_EQ(chords.front().position, 0u);
+    EXPECT_EQ(chords.back().position, std::uint32_t{1} << level);
+    const long double scale = std::ldexp(1.0L, -level);
+    for (std::size_t k = 0; k < chords.size(); ++k) {
+      for (int c = 0; c < 3; ++c) {
+        const I128 exact = ExactFine(raw[c], chords[k].position, level);
+        ASSERT_EQ(chords[k].fine[c], static_cast<std::int32_t>(static_cast<std::uint32_t>(exact)))
+            << "trial " << trial << " chord end " << k << " axis " << c;
+      }
+      if (k == 0) continue;
+      ASSERT_GT(chords[k].position, chords[k - 1].position);
+      if (budget_bits == kFinestStepsOnly) {
+        ASSERT_TRUE(chords[k].finest);
+        ASSERT_EQ(chords[k].position, chords[k - 1].position + 1);
+      }
+      const long double budget = std::ldexp(1.0L, -budget_bits);
+      const long double ta = chords[k - 1].position * scale;
+      const long double tb = chords[k].position * scale;
+      for (int c = 0; c < 3; ++c) {
+        const long double a = ExactValue(raw[c], ta);
+        const long double b = ExactValue(raw[c], tb);
+        EXPECT_LE(std::fabs(b - a), 256.0L) << "trial " << trial << " chord " << k;
+        if (chords[k].finest) {
+          EXPECT_LE(std::fabs(b - a), 1.0L + 1e-9L) << "trial " << trial << " chord " << k;
+          continue;
+        }
+        for (int i = 1; i < 32; ++i) {
+          const long double v = i / 32.0L;
+          const long double on_curve = ExactValue(raw[c], ta + (tb - ta) * v);
+          EXPECT_LE(std::fabs(on_curve - (a + (b - a) * v)), budget + 1e-9L)
+              << "trial " << trial << " chord " << k << " axis " << c;
+        }
+      }
+      if (!chords[k].finest && chords[k].position - chords[k - 1].position >= 4) ++long_chords;
+    }
+  }
+  // Chords of many finest steps are the rule. (A finest step whose chord
+  // exceeds the budget needs a turn of a few quanta's radius, which a
+  // step-exact level rarely leaves; ChordDda.AFinestStepIsOneEventToItsEnd
+  // tests what is done with one.)
+  EXPECT_GT(long_chords, 10000);
+}
+
+// The budget a tolerance leaves: a point rounded from a chord within it is
+// within the tolerance, √d·(1/2 + 2^-10 + 2^-8 + 2^-b) ≤ tol, and the budget
+// is the largest power of two (from 2^-6) that the integer test allows.
+TEST(ChordBudgetBits, LeavesEveryChordPointWithinTheTolerance) {
+  int finest_only = 0;
+  for (int dims = 1; dims <= 3; ++dims) {
+    const long double root = std::sqrt(static_cast<long double>(dims));
+    int last = kFinestStepsOnly;
+    for (std::uint32_t q8 = 1; q8 <= 4 * 256; ++q8) {
+      const long double tolerance = q8 / 256.0L;
+      if (tolerance <= root * (0.5L + std::ldexp(1.0L, -10))) continue;  // refused
+      const int bits = ChordBudgetBits(q8, dims);
+      if (bits == kFinestStepsOnly) {
+        ++finest_only;
+        EXPECT_EQ(last, kFinestStepsOnly) << q8;  // only at the smallest tolerances
+        continue;
+      }
+      ASSERT_GE(bits, kLargestChordBudgetBits);
+      ASSERT_LE(bits, kSmallestChordBudgetBits);
+      const long double reach =
+          0.5L + std::ldexp(1.0L, -10) + std::ldexp(1.0L, -8) + std::ldexp(1.0L, -bits);
+      EXPECT_LE(root * reach, tolerance) << "dims " << dims << " q8 " << q8;
+      if (last != kFinestStepsOnly) EXPECT_LE(bits, last) << q8;  // never tighter as tol grows
+      last = bits;
+    }
+    EXPECT_EQ(last, kLargestChordBudgetBits) << dims;  // 4 steps leave the largest
+  }
+  EXPECT_GT(finest_only, 0);
+}
+
 TEST(IsolineWalker, LineCoefficientsAreTheExactlyRoundedOnes) {
   std::mt19937_64 rng(5);
   const Basis bases[] = {Basis::kPower, Basis::kHermite, Basis::kBezier, Basis::kBSpline,

@@ -305,6 +305,118 @@ class AdaptiveCurveCursor {
   bool started_;
 };
 
+/// The chord budget of AdaptiveChordCursor for a command's tolerance: the
+/// largest 2^-b quanta per axis, b ≥ kLargestChordBudgetBits, such that a
+/// point rounded from a chord (docs/motion.md, "Path generation: chords") is
+/// within the tolerance: √d·(1/2 + 2^-10 + 2^-8 + 2^-b) ≤ tol. Returns b, or
+/// kFinestStepsOnly when even 2^-kSmallestChordBudgetBits does not fit (a
+/// tolerance within 2^-8·√d of the least one): then only finest steps.
+constexpr int kLargestChordBudgetBits = 6;
+constexpr int kSmallestChordBudgetBits = 16;
+constexpr int kFinestStepsOnly = 0;
+int ChordBudgetBits(uint32_t tolerance_q8, int dims);
+
+/// Walks a prepared adaptive curve as **chords** for a machine that steps
+/// each chord itself (a DDA; docs/motion.md, "Path generation: chords"):
+/// the longest power-of-two steps whose chord is within the budget
+/// (2^-budget_bits quanta per axis) of the curve and which move no axis more
+/// than 2^kMaxChordBits quanta where the accumulator can hold that limit
+/// (else the table's range keeps every chord within 2^(kMaxChordBits + 1)
+/// quanta). It takes any prepared table: the planner's range bound covers
+/// every step from the finest up to the whole curve (docs/toolpaths.md), and
+/// the finest step is always taken (a step-exact table's is at most one
+/// quantum). Points are reported finer than quanta, as
+/// floor((x + 1/2)·2^kFineBits) modulo 2^32 (x the point in quanta), so that
+/// consecutive points' difference (at most 2^(kMaxChordBits + 1) quanta per
+/// axis, times 2^kFineBits) and each point's fraction are exact on any
+/// travel; floor(point / 2^kFineBits) is the point rounded to quanta
+/// (halves up) where it is not wrapped.
+template <typename Acc, int kDims>
+class AdaptiveChordCursor {
+ public:
+  static constexpr int kFineBits = 8;
+  static constexpr int kMaxChordBits = 7;
+
+  /// Starts on `curve` with a budget of 2^-budget_bits quanta per axis,
+  /// kLargestChordBudgetBits ≤ budget_bits ≤ kSmallestChordBudgetBits, or
+  /// kFinestStepsOnly.
+  template <typename Entry>
+  void Reset(const PreparedAdaptiveCurve<kDims, Entry>& curve, int budget_bits) {
+    Acc half;
+    internal::RoundingHalf(curve.format.frac_bits, &half);
+    for (int c = 0; c < kDims; ++c) {
+      for (int k = 0; k < 4; ++k) internal::Load(curve.d[c][k], &d_[c][k]);
+      d_[c][0] += half;
+    }
+    frac_bits_ = curve.format.frac_bits;
+    if (budget_bits == kFinestStepsOnly) {
+      // A negative limit fails every test: no step doubles, each is finest.
+      Acc one;
+      internal::RoundingHalf(1, &one);
+      chord_limit_ = -one;
+    } else {
+      // The chord limit is 8·budget (the chord bound, docs/toolpaths.md):
+      // 2^(F + 3 − budget_bits) in the table's units (F ≥ 16).
+      internal::RoundingHalf(frac_bits_ + 4 - budget_bits, &chord_limit_);
+    }
+    quarter_chord_limit_ = internal::ShiftRightArithmetic(chord_limit_, 2);
+    // A table's values are below 2^62 (int64_t) or 2^126 (Int128). Where
+    // 2^(F + kMaxChordBits) is not, no point is 2^kMaxChordBits quanta from
+    // the first, so no chord moves an axis 2^(kMaxChordBits + 1): no test.
+    const int acc_limit_bits = sizeof(Acc) == 8 ? 62 : 126;
+    capped_ = frac_bits_ + kMaxChordBits < acc_limit_bits;
+    step_limit_ = chord_limit_;  // unused when not capped
+    if (capped_) internal::RoundingHalf(frac_bits_ + kMaxChordBits + 1, &step_limit_);
+    end_ = uint32_t{1} << curve.finest_level;
+    position_ = 0;
+    step_ = 1;
+    started_ = false;
+  }
+
+  /// The next chord end (the first point first) in 2^-kFineBits quanta as
+  /// above; *finest: the chord is one finest step (2^-L), which a step-exact
+  /// table's planner proved moves each axis at most one quantum, though its
+  /// chord may exceed the budget. Returns false after the last.
+  bool Next(int32_t (&fine)[kDims], bool* finest) {
+    if (started_) {
+      if (position_ >= end_) return false;
+      // Halve when the step fails or would overshoot t = 1; the finest step
+      // is taken as it is (step_ = 1 ends the halving).
+      while (step_ > 1 && (step_ > end_ - position_ ||
+                           !internal::StepFits(d_, chord_limit_, step_limit_, capped_))) {
+        for (int c = 0; c < kDims; ++c) internal::HalveStep(d_[c]);
+        step_ >>= 1;
+      }
+      while (step_ <= (end_ - position_) / 2 &&
+             internal::DoubledStepFits(d_, quarter_chord_limit_, step_limit_, capped_)) {
+        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d_[c]);
+        step_ <<= 1;
+      }
+      for (int c = 0; c < kDims; ++c) internal::Step(d_[c]);
+      position_ += step_;
+    }
+    started_ = true;
+    *finest = step_ == 1;
+    for (int c = 0; c < kDims; ++c) fine[c] = FloorToQuanta(d_[c][0], frac_bits_ - kFineBits);
+    return true;
+  }
+
+  /// Where the last point is, in units of 2^-finest_level of the parameter.
+  FDSURF_NODISCARD uint32_t position() const { return position_; }
+
+ private:
+  Acc d_[kDims][4];
+  Acc chord_limit_;
+  Acc quarter_chord_limit_;
+  Acc step_limit_;
+  uint32_t end_;
+  uint32_t position_;
+  uint32_t step_;  // in units of the finest step
+  uint8_t frac_bits_;
+  bool capped_;
+  bool started_;
+};
+
 /// Steps a prepared adaptive curve with accumulator Acc (int64_t only when
 /// format.acc_bits == 64, else Int128). Sink is called as
 /// sink(position, point): position in units of 2^-finest_level of the
