@@ -172,8 +172,11 @@ BOARDS = {
                     "limits": MICROBIT_LIMITS,
                     "job_args": "--fit 40x30 --lines 2 "
                                 "--servo-pulse-up 1200 --servo-pulse-down 1800"},
+    # 3 lines each way: 5.3 s, so that the STOP (2 s + 40 % of the job after
+    # the start) falls well inside it (2 lines took 3.0 s once the device
+    # stepped chords, and the STOP came after the end).
     "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
-                "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 2"},
+                "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 3"},
 }
 # A servo pulse starts every 20 ms (50 Hz; a board's "servo_period_ns" says
 # otherwise); under simavr a width written at a

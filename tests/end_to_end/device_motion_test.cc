@@ -354,8 +354,11 @@ std::array<long double, 2> ExactBezier(const protocol::PatchCommand& patch, long
   return p;
 }
 
-TEST(PathGenerator, PatchIsolinesAreStepExactAndWithinTheTolerance) {
-  const protocol::Command command = BumpPatch(100, 900, 250, 5, 3 * 256);
+// A patch's 5 + 5 isolines as the generator expands them: in order and
+// direction, ending on their ends rounded, one step per axis at most, and
+// every point within the tolerance of the exact line (dense samples).
+void CheckPatchIsolines(std::uint32_t tolerance_q8) {
+  const protocol::Command command = BumpPatch(100, 900, 250, 5, tolerance_q8);
   const protocol::PatchCommand& patch = command.body.patch;
   uint8_t detail = 0;
   ASSERT_EQ(motion::ValidateCommand<2>(command, Config(4000), &detail), protocol::ErrorCode::kNone);
@@ -426,6 +429,13 @@ TEST(PathGenerator, PatchIsolinesAreStepExactAndWithinTheTolerance) {
     }
   }
 }
+
+TEST(PathGenerator, PatchIsolinesAreStepExactAndWithinTheTolerance) { CheckPatchIsolines(3 * 256); }
+
+// At 0.72 steps, within 0.015 of the least tolerance in 2-D (0.708), the
+// chords' budget is 2^-8 (ChordBudgetBits), as the bound needs (with 2^-6 it
+// would be 0.736 steps): shorter chords, and every point within 0.72.
+TEST(PathGenerator, PatchIsolinesAreWithinTheToleranceAtTheLeastOne) { CheckPatchIsolines(185); }
 
 TEST(PathGenerator, LeavesOutTheEdgesAnotherPatchDraws) {
   for (const std::uint8_t skip : {0, 1, 2, 4, 8, 5, 15}) {
@@ -529,6 +539,103 @@ TEST(StraightMoveCursor, EmitsTheAdaptiveCursorsPointsOfTheMove) {
     for (int c = 0; c < 3; ++c) EXPECT_EQ(point[c], to[c]) << trial;
   }
   EXPECT_GT(checked, 1000000);
+}
+
+// The DDA of a line's chords against the closed form it promises: event k
+// of N = ⌈max |Q − P| / 2^8⌉ lands on floor((P + k·(Q − P)/N) / 2^8), computed
+// here in 64 bits from unwrapped points while the DDA gets them wrapped to 32
+// bits, near the wrap and far from it, over chains of chords; every point
+// moves each axis at most one step, repeats are left out, and the chain ends
+// on the last point rounded.
+TEST(ChordDda, EveryPointIsTheExactChordPointRounded) {
+  std::mt19937_64 rng(20261207);
+  int events_checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    // Near the int32 wrap (2^31 / 2^8 steps) on odd trials.
+    std::int64_t fine[3];
+    for (auto& f : fine) {
+      f = static_cast<std::int64_t>(rng() % (1u << 20)) +
+          (trial % 2 == 1 ? (std::int64_t{1} << 31) - (1 << 19) : 0);
+    }
+    const auto floor256 = [](std::int64_t v) { return v >= 0 ? v / 256 : -((-v + 255) / 256); };
+    const auto wrapped = [](std::int64_t v) {
+      return static_cast<std::int32_t>(static_cast<std::uint32_t>(static_cast<std::uint64_t>(v)));
+    };
+    std::int32_t start[3];
+    std::int32_t point[3];
+    for (int c = 0; c < 3; ++c) {
+      start[c] = wrapped(fine[c]);
+      point[c] = static_cast<std::int32_t>(floor256(fine[c]));
+    }
+    motion::ChordDda<3> dda;
+    dda.Start(start, point);
+    std::array<std::int64_t, 3> at{point[0], point[1], point[2]};
+    for (int chord = 0; chord < 8; ++chord) {
+      const std::int64_t reach = std::int64_t{1} << (rng() % 17);  // up to 256 steps
+      std::int64_t delta[3];
+      std::int32_t next[3];
+      std::int64_t events = 1;
+      for (int c = 0; c < 3; ++c) {
+        delta[c] = static_cast<std::int64_t>(rng() % (2 * reach + 1)) - reach;
+        next[c] = wrapped(fine[c] + delta[c]);
+        events = std::max<std::int64_t>(events, (std::llabs(delta[c]) + 255) / 256);
+      }
+      dda.Chord(next, false);
+      std::vector<std::array<std::int64_t, 3>> expected;
+      for (std::int64_t k = 1; k <= events; ++k) {
+        std::array<std::int64_t, 3> p{};
+        for (int c = 0; c < 3; ++c) {
+          const std::int64_t numerator = events * fine[c] + k * delta[c];
+          const std::int64_t modulus = 256 * events;
+          p[c] = numerator >= 0 ? numerator / modulus : -((-numerator + modulus - 1) / modulus);
+        }
+        if (p != (expected.empty() ? at : expected.back())) expected.push_back(p);
+      }
+      for (const auto& p : expected) {
+        ASSERT_TRUE(dda.Next(point)) << trial;
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(point[c], static_cast<std::int32_t>(p[c])) << trial << " chord " << chord;
+          ASSERT_LE(std::llabs(p[c] - at[c]), 1) << trial;
+        }
+        at = p;
+        ++events_checked;
+      }
+      ASSERT_FALSE(dda.Next(point)) << trial;
+      for (int c = 0; c < 3; ++c) {
+        fine[c] += delta[c];
+        EXPECT_EQ(at[c], floor256(fine[c])) << trial;
+      }
+    }
+  }
+  EXPECT_GT(events_checked, 100000);
+}
+
+// A finest step is one event: its ends, each the curve's point rounded, are
+// at most one step apart, and the chord between them (whose error the
+// budget does not bound) is not sampled. The same chord as an ordinary one
+// is two events, and the first lands on its midpoint rounded.
+TEST(ChordDda, AFinestStepIsOneEventToItsEnd) {
+  const std::int32_t start[2] = {127, 250};  // the point (0, 0)
+  const std::int32_t origin[2] = {0, 0};
+  const std::int32_t end[2] = {127 + 257, 300};  // (1, 1), 257/256 steps along x
+  std::int32_t point[2];
+  motion::ChordDda<2> finest;
+  finest.Start(start, origin);
+  finest.Chord(end, true);
+  ASSERT_TRUE(finest.Next(point));
+  EXPECT_EQ(point[0], 1);
+  EXPECT_EQ(point[1], 1);
+  EXPECT_FALSE(finest.Next(point));
+  motion::ChordDda<2> ordinary;
+  ordinary.Start(start, origin);
+  ordinary.Chord(end, false);
+  ASSERT_TRUE(ordinary.Next(point));
+  EXPECT_EQ(point[0], 0);  // floor((2·127 + 257) / 512)
+  EXPECT_EQ(point[1], 1);  // floor((2·250 + 50) / 512)
+  ASSERT_TRUE(ordinary.Next(point));
+  EXPECT_EQ(point[0], 1);
+  EXPECT_EQ(point[1], 1);
+  EXPECT_FALSE(ordinary.Next(point));
 }
 
 TEST(ValidateCommand, RefusesWhatWouldLeaveTheTravelOrTheEngine) {

@@ -402,6 +402,66 @@ bool StraightMoveCursor<kDims>::Next(int32_t (&point)[kDims]) {
 }
 
 template <int kDims>
+void ChordDda<kDims>::Start(const int32_t (&fine)[kDims], const int32_t (&point)[kDims]) {
+  for (int c = 0; c < kDims; ++c) {
+    fine_[c] = fine[c];
+    point_[c] = point[c];
+  }
+  remaining_ = 0;
+}
+
+template <int kDims>
+void ChordDda<kDims>::Chord(const int32_t (&fine)[kDims], bool finest) {
+  uint32_t events = 1;
+  for (int c = 0; c < kDims; ++c) {
+    // The difference of two wrapped points is exact: a chord moves an axis
+    // at most 2^8 steps (AdaptiveChordCursor), far below 2^31 / 2^8.
+    increment_[c] =
+        static_cast<int32_t>(static_cast<uint32_t>(fine[c]) - static_cast<uint32_t>(fine_[c]));
+    const uint32_t magnitude =
+        static_cast<uint32_t>(increment_[c] < 0 ? -increment_[c] : increment_[c]);
+    const uint32_t needed = (magnitude + ((1u << kFineBits) - 1)) >> kFineBits;
+    if (needed > events) events = needed;
+  }
+  if (finest) events = 1;
+  modulus_ = static_cast<int32_t>(events << kFineBits);
+  for (int c = 0; c < kDims; ++c) {
+    // N·P − 2^8·N·floor(P / 2^8) = N·(P mod 2^8): the start's fraction, which
+    // wrapping (by a multiple of 2^8) keeps.
+    remainder_[c] = static_cast<int32_t>(events * (static_cast<uint32_t>(fine_[c]) & 0xFFu));
+    fine_[c] = fine[c];
+  }
+  remaining_ = static_cast<uint16_t>(events);
+}
+
+template <int kDims>
+bool ChordDda<kDims>::Next(int32_t (&point)[kDims]) {
+  while (remaining_ > 0) {
+    --remaining_;
+    bool moved = false;
+    for (int c = 0; c < kDims; ++c) {
+      // |increment| ≤ modulus (≤ 2^8 per event), so at most one step; for a
+      // finest step the ends are at most one step apart.
+      remainder_[c] += increment_[c];
+      if (remainder_[c] >= modulus_) {
+        remainder_[c] -= modulus_;
+        ++point_[c];
+        moved = true;
+      } else if (remainder_[c] < 0) {
+        remainder_[c] += modulus_;
+        --point_[c];
+        moved = true;
+      }
+    }
+    if (moved) {
+      for (int c = 0; c < kDims; ++c) point[c] = point_[c];
+      return true;
+    }
+  }
+  return false;
+}
+
+template <int kDims>
 int StraightMoveLevel(const PowerCurve1 (&line)[kDims]) {
   uint64_t largest = 0;
   for (int c = 0; c < kDims; ++c) {
@@ -515,16 +575,39 @@ bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32
     Fail(status);
     return false;
   }
+  // Chords within what the tolerance leaves after rounding, so that every
+  // point stepped from them is within it (docs/motion.md).
+  const int budget_bits = ChordBudgetBits(tolerance_q8, kDims);
 #if FDSURF_DEVICE_WIDE_TABLES
   if (prepared_.format.acc_bits != 64) {
     path_ = Path::kLine128;
-    cursor128_.Reset(prepared_);
-    return true;
+    cursor128_.Reset(prepared_, budget_bits);
+  } else {
+    path_ = Path::kLine64;
+    cursor64_.Reset(prepared_, budget_bits);
   }
-#endif
+#else
   path_ = Path::kLine64;
-  cursor64_.Reset(prepared_);
+  cursor64_.Reset(prepared_, budget_bits);
+#endif
+  // The first point: the relative line starts within half a step of 0, so
+  // its fine value has not wrapped and rounds to 0.
+  int32_t fine[kDims];
+  bool finest = false;
+  (void)NextChord(fine, &finest);
+  int32_t origin[kDims];
+  for (int c = 0; c < kDims; ++c)
+    origin[c] = fine[c] >> AdaptiveChordCursor<int64_t, kDims>::kFineBits;
+  dda_.Start(fine, origin);
   return true;
+}
+
+template <int kDims>
+bool PathGenerator<kDims>::NextChord(int32_t (&fine)[kDims], bool* finest) {
+#if FDSURF_DEVICE_WIDE_TABLES
+  if (path_ == Path::kLine128) return cursor128_.Next(fine, finest);
+#endif
+  return cursor64_.Next(fine, finest);
 }
 
 template <int kDims>
@@ -619,16 +702,16 @@ void PathGenerator<kDims>::Start(const protocol::Command& command) {
 template <int kDims>
 bool PathGenerator<kDims>::NextPoint(int32_t (&point)[kDims]) {
   if (path_ == Path::kStraight) return straight_.Next(point);
-  uint32_t position = 0;
-#if FDSURF_DEVICE_WIDE_TABLES
-  const bool more = path_ == Path::kLine128 ? cursor128_.Next(point, &position)
-                                            : cursor64_.Next(point, &position);
-#else
-  const bool more = cursor64_.Next(point, &position);
-#endif
-  if (!more) return false;
-  for (int c = 0; c < kDims; ++c) point[c] += line_start_[c];
-  return true;
+  for (;;) {
+    if (dda_.Next(point)) {
+      for (int c = 0; c < kDims; ++c) point[c] += line_start_[c];
+      return true;
+    }
+    int32_t fine[kDims];
+    bool finest = false;
+    if (!NextChord(fine, &finest)) return false;
+    dda_.Chord(fine, finest);
+  }
 }
 
 // One state machine over the stages of a command (stepping, next line,
@@ -753,6 +836,8 @@ template void RelativeToFirstPoint<3>(const PowerCurve1 (&)[3], PowerCurve1 (&)[
 template bool HullWithinTravel<2>(const PowerCurve1 (&)[2], const int32_t*);
 template bool HullWithinTravel<3>(const PowerCurve1 (&)[3], const int32_t*);
 template class StraightMoveCursor<2>;
+template class ChordDda<2>;
+template class ChordDda<3>;
 template class StraightMoveCursor<3>;
 template int StraightMoveLevel<2>(const PowerCurve1 (&)[2]);
 template int StraightMoveLevel<3>(const PowerCurve1 (&)[3]);

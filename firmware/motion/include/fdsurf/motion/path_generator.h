@@ -148,6 +148,39 @@ class StraightMoveCursor {
   bool started_ = false;
 };
 
+/// The unit moves of a line's chords (AdaptiveChordCursor, docs/motion.md,
+/// "Path generation: chords"): a chord from P to Q, both in 2^-8 steps with
+/// the rounding half in (floor((x + 1/2)·2^8), wrapping), is cut into N
+/// events, N = ⌈max |Q − P| / 2^8⌉ (at least 1, and 1 for a finest step),
+/// and event k lands on floor((P + k·(Q − P)/N) / 2^8): the exact chord point
+/// rounded to steps. Kept as the point and the remainder of N·P + k·(Q − P)
+/// over 2^8·N, so an event is one 32-bit addition and comparison per axis;
+/// no axis moves more than one step in an event, and event N is Q rounded.
+template <int kDims>
+class ChordDda {
+ public:
+  /// Starts at `fine` (the cursor's first point) with the point `point`
+  /// (steps): floor(fine / 2^8) where fine has not wrapped.
+  void Start(const int32_t (&fine)[kDims], const int32_t (&point)[kDims]);
+  /// Steps the chord from the last point given to `fine` next; `finest`:
+  /// it is one finest step, taken as one event (its ends are within one
+  /// step per axis, AdaptiveChordCursor).
+  void Chord(const int32_t (&fine)[kDims], bool finest);
+  /// The next point of the chord that differs from the one before; false
+  /// when the chord is done.
+  bool Next(int32_t (&point)[kDims]);
+
+ private:
+  static constexpr int kFineBits = 8;
+  int32_t fine_[kDims] = {};  // where the next chord starts
+  int32_t point_[kDims] = {};
+  // 0 ≤ remainder_ < modulus_ = 2^8·N; each event adds increment_ = Q − P.
+  int32_t remainder_[kDims] = {};
+  int32_t increment_[kDims] = {};
+  int32_t modulus_ = 1;
+  uint16_t remaining_ = 0;  // events still to take
+};
+
 /// Whether every axis's travel is at most kMaxPlannableTravelSteps; *axis =
 /// the first that is not.
 template <int kDims>
@@ -216,6 +249,8 @@ class PathGenerator {
   /// cursor at it.
   bool PrepareInto(const PowerCurve1 (&curve)[kDims], uint32_t tolerance_q8, int host_level);
   bool NextPoint(int32_t (&point)[kDims]);
+  /// The line's next chord end from its cursor; false after the last.
+  bool NextChord(int32_t (&fine)[kDims], bool* finest);
   /// Queues an entry to hand out before anything else.
   void Emit(uint8_t entry);
   /// Starts a straight pen-at-current-state move to `target`.
@@ -255,11 +290,13 @@ class PathGenerator {
   StraightMoveCursor<kDims> straight_;
 #if FDSURF_DEVICE_WIDE_TABLES
   PreparedAdaptiveCurve<kDims> prepared_;
-  AdaptiveCurveCursor<Int128, kDims> cursor128_;
+  AdaptiveChordCursor<Int128, kDims> cursor128_;
 #else
   PreparedAdaptiveCurve<kDims, int64_t> prepared_;
 #endif
-  AdaptiveCurveCursor<int64_t, kDims> cursor64_;
+  AdaptiveChordCursor<int64_t, kDims> cursor64_;
+  /// The unit moves of the line's current chord, relative to line_start_.
+  ChordDda<kDims> dda_;
 
   // Entries to hand out before stepping on (at most a pen event and a
   // command-done marker at a time).
