@@ -570,7 +570,12 @@ bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32
                                        int host_level) {
   PowerCurve1 relative[kDims];
   RelativeToFirstPoint(curve, relative, line_start_);
-  const Status status = PrepareLine(relative, tolerance_q8, host_level, &prepared_);
+#if FDSURF_DEVICE_WIDE_TABLES
+  PreparedAdaptiveCurve<kDims> prepared;
+#else
+  PreparedAdaptiveCurve<kDims, int64_t> prepared;
+#endif
+  const Status status = PrepareLine(relative, tolerance_q8, host_level, &prepared);
   if (status != Status::kOk) {
     Fail(status);
     return false;
@@ -579,16 +584,16 @@ bool PathGenerator<kDims>::PrepareInto(const PowerCurve1 (&curve)[kDims], uint32
   // point stepped from them is within it (docs/motion.md).
   const int budget_bits = ChordBudgetBits(tolerance_q8, kDims);
 #if FDSURF_DEVICE_WIDE_TABLES
-  if (prepared_.format.acc_bits != 64) {
+  if (prepared.format.acc_bits != 64) {
     path_ = Path::kLine128;
-    cursor128_.Reset(prepared_, budget_bits);
+    cursor128_.Reset(prepared, budget_bits);
   } else {
     path_ = Path::kLine64;
-    cursor64_.Reset(prepared_, budget_bits);
+    cursor64_.Reset(prepared, budget_bits);
   }
 #else
   path_ = Path::kLine64;
-  cursor64_.Reset(prepared_, budget_bits);
+  cursor64_.Reset(prepared, budget_bits);
 #endif
   // The first point: the relative line starts within half a step of 0, so
   // its fine value has not wrapped and rounds to 0.
