@@ -356,6 +356,33 @@ void RelativeToFirstPoint(const PowerCurve1 (&curve)[kDims], PowerCurve1 (&relat
   }
 }
 
+namespace {
+
+// One event of a DDA (StraightMoveCursor, ChordDda): each axis's remainder
+// gains its increment and carries a step into the point when it leaves
+// [0, modulus). The callers keep the point one step at most from the
+// event's exact rounding, so one carry suffices. Whether any axis moved.
+template <int kDims>
+inline bool DdaEvent(int32_t (&remainder)[kDims], const int32_t (&increment)[kDims],
+                     int32_t modulus, int32_t (&point)[kDims]) {
+  bool moved = false;
+  for (int c = 0; c < kDims; ++c) {
+    remainder[c] += increment[c];
+    if (remainder[c] >= modulus) {
+      remainder[c] -= modulus;
+      ++point[c];
+      moved = true;
+    } else if (remainder[c] < 0) {
+      remainder[c] += modulus;
+      --point[c];
+      moved = true;
+    }
+  }
+  return moved;
+}
+
+}  // namespace
+
 template <int kDims>
 void StraightMoveCursor<kDims>::Reset(const int32_t (&from)[kDims], const int32_t (&to)[kDims],
                                       int level) {
@@ -379,21 +406,7 @@ bool StraightMoveCursor<kDims>::Next(int32_t (&point)[kDims]) {
   }
   while (remaining_ > 0) {
     --remaining_;
-    bool moved = false;
-    for (int c = 0; c < kDims; ++c) {
-      // |increment| ≤ modulus, so the point moves by at most one.
-      remainder_[c] += increment_[c];
-      if (remainder_[c] >= modulus_) {
-        remainder_[c] -= modulus_;
-        ++point_[c];
-        moved = true;
-      } else if (remainder_[c] < 0) {
-        remainder_[c] += modulus_;
-        --point_[c];
-        moved = true;
-      }
-    }
-    if (moved) {
+    if (DdaEvent(remainder_, increment_, modulus_, point_)) {
       for (int c = 0; c < kDims; ++c) point[c] = point_[c];
       return true;
     }
@@ -438,22 +451,9 @@ template <int kDims>
 bool ChordDda<kDims>::Next(int32_t (&point)[kDims]) {
   while (remaining_ > 0) {
     --remaining_;
-    bool moved = false;
-    for (int c = 0; c < kDims; ++c) {
-      // |increment| ≤ modulus (≤ 2^8 per event), so at most one step; for a
-      // finest step the ends are at most one step apart.
-      remainder_[c] += increment_[c];
-      if (remainder_[c] >= modulus_) {
-        remainder_[c] -= modulus_;
-        ++point_[c];
-        moved = true;
-      } else if (remainder_[c] < 0) {
-        remainder_[c] += modulus_;
-        --point_[c];
-        moved = true;
-      }
-    }
-    if (moved) {
+    // |increment| ≤ modulus (≤ 2^8 per event), so at most one step; for a
+    // finest step the ends are at most one step apart.
+    if (DdaEvent(remainder_, increment_, modulus_, point_)) {
       for (int c = 0; c < kDims; ++c) point[c] = point_[c];
       return true;
     }
