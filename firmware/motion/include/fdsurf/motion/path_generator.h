@@ -2,15 +2,17 @@
 // Expands queued commands (patches, curves, straight moves, pen changes) into
 // the motion loop's entries: unit moves and pen events.
 //
-// Every path is a step-exact adaptive forward-difference path
-// (fdsurf/adaptive.h, AdaptiveMode::kStepExact): consecutive points differ by
-// at most one step per axis, and every chord between them is within the
-// command's tolerance of the exact curve. A patch is drawn as isolines with
+// A line is prepared as a step-exact adaptive table (fdsurf/adaptive.h,
+// AdaptiveMode::kStepExact; what the validation on arrival checked), walked
+// in chords within a budget of the curve (AdaptiveChordCursor), and each
+// chord cut into unit moves by a DDA (ChordDda): consecutive points differ
+// by at most one step per axis, and every point is within the command's
+// tolerance of the exact curve (docs/motion.md). A patch is drawn as isolines with
 // the IsolineWalker: s-lines then t-lines, every other line reversed
 // (serpentine) so that pen-up travel stays short; each line starts with a
 // pen-up straight move to its first point when the pen is elsewhere. Straight
-// moves are degree-1 curves stepped the same way: every point is a point of
-// the exact line with its coordinates rounded.
+// moves are stepped by StraightMoveCursor, the same DDA: every point is a
+// point of the exact line with its coordinates rounded.
 #pragma once
 
 #include <stdint.h>
