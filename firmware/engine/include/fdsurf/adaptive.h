@@ -215,6 +215,30 @@ inline void HalveStep(Acc* d) {
   d[3] = ShiftRightArithmetic(d[3], 3);
 }
 
+/// One step of an adaptive cursor at *position (units of the finest step,
+/// *step long before, end the last): halves while the step fails its tests
+/// or would overshoot `end`, down to the finest step at most (which is then
+/// taken as it is); doubles while the doubled step passes and stays within
+/// `end`; then steps the table and advances *position by the step taken.
+/// `test_step`: the Δ¹ test against step_limit applies too.
+template <typename Acc, int kDims>
+inline void AdaptAndStep(Acc (&d)[kDims][4], const Acc& chord_limit, const Acc& quarter_chord_limit,
+                         const Acc& step_limit, bool test_step, uint32_t end, uint32_t* step,
+                         uint32_t* position) {
+  while (*step > 1 &&
+         (*step > end - *position || !StepFits(d, chord_limit, step_limit, test_step))) {
+    for (int c = 0; c < kDims; ++c) HalveStep(d[c]);
+    *step >>= 1;
+  }
+  while (*step <= (end - *position) / 2 &&
+         DoubledStepFits(d, quarter_chord_limit, step_limit, test_step)) {
+    for (int c = 0; c < kDims; ++c) DoubleStep(d[c]);
+    *step <<= 1;
+  }
+  for (int c = 0; c < kDims; ++c) Step(d[c]);
+  *position += *step;
+}
+
 }  // namespace internal
 
 /// Steps a prepared adaptive curve one point at a time, with accumulator Acc
@@ -263,20 +287,9 @@ class AdaptiveCurveCursor {
       return true;
     }
     while (position_ < end_) {
-      // Halve when the step fails or would overshoot t = 1. The planner
-      // proved the finest step always passes, so this stops at 1 at the latest.
-      while (step_ > 1 && (step_ > end_ - position_ ||
-                           !internal::StepFits(d_, chord_limit_, step_limit_, step_exact_))) {
-        for (int c = 0; c < kDims; ++c) internal::HalveStep(d_[c]);
-        step_ >>= 1;
-      }
-      while (step_ <= (end_ - position_) / 2 &&
-             internal::DoubledStepFits(d_, quarter_chord_limit_, step_limit_, step_exact_)) {
-        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d_[c]);
-        step_ <<= 1;
-      }
-      for (int c = 0; c < kDims; ++c) internal::Step(d_[c]);
-      position_ += step_;
+      // The planner proved the finest step always passes.
+      internal::AdaptAndStep(d_, chord_limit_, quarter_chord_limit_, step_limit_, step_exact_, end_,
+                             &step_, &position_);
       bool moved = !step_exact_;
       for (int c = 0; c < kDims; ++c) {
         point[c] = FloorToQuanta(d_[c][0], frac_bits_);
@@ -380,20 +393,9 @@ class AdaptiveChordCursor {
   bool Next(int32_t (&fine)[kDims], bool* finest) {
     if (started_) {
       if (position_ >= end_) return false;
-      // Halve when the step fails or would overshoot t = 1; the finest step
-      // is taken as it is (step_ = 1 ends the halving).
-      while (step_ > 1 && (step_ > end_ - position_ ||
-                           !internal::StepFits(d_, chord_limit_, step_limit_, capped_))) {
-        for (int c = 0; c < kDims; ++c) internal::HalveStep(d_[c]);
-        step_ >>= 1;
-      }
-      while (step_ <= (end_ - position_) / 2 &&
-             internal::DoubledStepFits(d_, quarter_chord_limit_, step_limit_, capped_)) {
-        for (int c = 0; c < kDims; ++c) internal::DoubleStep(d_[c]);
-        step_ <<= 1;
-      }
-      for (int c = 0; c < kDims; ++c) internal::Step(d_[c]);
-      position_ += step_;
+      // A finest step that fails the budget is taken as it is.
+      internal::AdaptAndStep(d_, chord_limit_, quarter_chord_limit_, step_limit_, capped_, end_,
+                             &step_, &position_);
     }
     started_ = true;
     *finest = step_ == 1;
