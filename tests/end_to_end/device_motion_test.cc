@@ -32,11 +32,16 @@ using motion::TickOutput;
 constexpr std::uint32_t kTickHz = 40000;
 
 motion::TickLimits Limits(std::uint32_t max_rate, std::uint32_t accel,
-                          std::uint16_t pen_delay_ms = 0) {
+                          std::uint16_t pen_delay_ms = 0, std::uint8_t slice_ticks = 1) {
   motion::TickLimits limits{};
-  EXPECT_TRUE(motion::ToTickLimits({kTickHz, max_rate, accel, pen_delay_ms, max_rate}, &limits));
+  EXPECT_TRUE(motion::ToTickLimits(
+      {kTickHz, max_rate, accel, pen_delay_ms, max_rate, {0, 0, 0}, slice_ticks}, &limits));
   return limits;
 }
+
+// The slice lengths every profile test runs with: the tick itself, and the
+// slices the boards use (docs/motion.md, "Slices").
+constexpr std::uint8_t kSlices[] = {1, 4, 16};
 
 // Runs the loop to idle, recording what it did as the sim HAL would.
 struct Recording {
@@ -92,21 +97,25 @@ TEST(MotionLimits, RefusesWhatTheLoopCannotServe) {
 
 TEST(MotionLoop, StraightRunIsATrapezoidWithinTheLimits) {
   std::vector<std::uint8_t> storage(4096);
-  for (const int steps : {1, 7, 150, 1000, 3000}) {
-    MotionLoop loop(storage.data(), static_cast<std::uint16_t>(storage.size()));
-    loop.Configure(Limits(8000, 160000));
-    const std::int32_t right[2] = {1, 0};
-    for (int i = 0; i < steps; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
-    ASSERT_TRUE(loop.Push(MakeEntry(EntryKind::kPenUp)));  // a rest at the end
-    const Recording r = RunToIdle(&loop);
-    ASSERT_EQ(r.steps.size(), static_cast<std::size_t>(steps));
-    EXPECT_EQ(loop.position()[0], steps);
-    const sim::MotionReport report =
-        sim::CheckMotion(r.steps, r.pens, SiLimits(8000, 160000), 0.02);
-    EXPECT_EQ(report.violations, 0u) << steps << " steps: " << report.first_violation;
-    // Not needlessly slow either: within 2% (plus a few ticks) of the ideal trapezoid.
-    const double ideal = IdealSeconds(steps, 8000, 160000);
-    EXPECT_LE(r.ticks, ideal * kTickHz * 1.02 + 5) << steps << " steps";
+  for (const std::uint8_t slice : kSlices) {
+    for (const int steps : {1, 7, 150, 1000, 3000}) {
+      SCOPED_TRACE(testing::Message() << int{slice} << " ticks a slice");
+      MotionLoop loop(storage.data(), static_cast<std::uint16_t>(storage.size()));
+      loop.Configure(Limits(8000, 160000, 0, slice));
+      const std::int32_t right[2] = {1, 0};
+      for (int i = 0; i < steps; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
+      ASSERT_TRUE(loop.Push(MakeEntry(EntryKind::kPenUp)));  // a rest at the end
+      const Recording r = RunToIdle(&loop);
+      ASSERT_EQ(r.steps.size(), static_cast<std::size_t>(steps));
+      EXPECT_EQ(loop.position()[0], steps);
+      const sim::MotionReport report =
+          sim::CheckMotion(r.steps, r.pens, SiLimits(8000, 160000), 0.02);
+      EXPECT_EQ(report.violations, 0u) << steps << " steps: " << report.first_violation;
+      // Not needlessly slow either: within 2% (plus a few ticks, and two
+      // slices for the choices a slice late) of the ideal trapezoid.
+      const double ideal = IdealSeconds(steps, 8000, 160000);
+      EXPECT_LE(r.ticks, ideal * kTickHz * 1.02 + 5 + 2 * slice) << steps << " steps";
+    }
   }
 }
 
@@ -141,11 +150,12 @@ TEST(MotionLoop, DiagonalMovesCountTheirLength) {
 TEST(MotionLoop, RandomPathsWithPenEventsAndStarvationKeepTheLimits) {
   std::mt19937_64 rng(7);
   std::vector<std::uint8_t> storage(256);
-  for (int trial = 0; trial < 20; ++trial) {
+  for (int trial = 0; trial < 30; ++trial) {
     MotionLoop loop(storage.data(), 256);
     const std::uint32_t rate = 2000 + static_cast<std::uint32_t>(rng() % 20000);
     const std::uint32_t accel = 20000 + static_cast<std::uint32_t>(rng() % 400000);
-    loop.Configure(Limits(rate, accel, 5));
+    const std::uint8_t slice = kSlices[trial % 3];
+    loop.Configure(Limits(rate, accel, 5, slice));
     // The producer feeds a random number of entries between ticks, sometimes none.
     std::vector<std::uint8_t> entries;
     std::array<std::int64_t, 3> expected{0, 0, 0};
@@ -176,7 +186,8 @@ TEST(MotionLoop, RandomPathsWithPenEventsAndStarvationKeepTheLimits) {
     for (int a = 0; a < 3; ++a) EXPECT_EQ(loop.position()[a], expected[a]) << "axis " << a;
     const sim::MotionReport report =
         sim::CheckMotion(r.steps, r.pens, SiLimits(rate, accel, 5e-3), 0.02);
-    EXPECT_EQ(report.violations, 0u) << "trial " << trial << ": " << report.first_violation;
+    EXPECT_EQ(report.violations, 0u)
+        << "trial " << trial << " (" << int{slice} << " ticks a slice): " << report.first_violation;
   }
 }
 
@@ -248,26 +259,89 @@ TEST(MotionLoop, HoldsAtMostItsPenEventsAtOnce) {
 
 TEST(MotionLoop, StopDeceleratesAlongThePathWithinTheLimit) {
   std::vector<std::uint8_t> storage(4096);
-  MotionLoop loop(storage.data(), 4096);
-  const motion::TickLimits limits = Limits(8000, 160000);
-  loop.Configure(limits);
-  const std::int32_t right[2] = {1, 0};
-  for (int i = 0; i < 4000; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
-  for (int t = 0; t < 3000; ++t) loop.Tick();  // well under way, at full speed
-  const std::uint32_t before = loop.speed();
-  ASSERT_GT(before, limits.accel * 1000);
-  loop.Stop();
-  std::uint32_t previous = before;
-  int ticks = 0;
-  while (loop.speed() > 0 && ticks < 100000) {
-    loop.Tick();
-    EXPECT_LE(previous - loop.speed(), limits.accel);  // never faster than the limit
-    previous = loop.speed();
-    ++ticks;
+  for (const std::uint8_t slice : kSlices) {
+    SCOPED_TRACE(testing::Message() << int{slice} << " ticks a slice");
+    MotionLoop loop(storage.data(), 4096);
+    const motion::TickLimits limits = Limits(8000, 160000, 0, slice);
+    loop.Configure(limits);
+    const std::int32_t right[2] = {1, 0};
+    for (int i = 0; i < 4000; ++i) ASSERT_TRUE(loop.Push(MakeMove(right, 2)));
+    for (int t = 0; t < 3000; ++t) loop.Tick();  // well under way, at full speed
+    const std::uint32_t before = loop.speed();
+    ASSERT_GT(before, limits.accel * 100);
+    loop.Stop();
+    std::uint32_t previous = before;
+    int ticks = 0;
+    while (loop.speed() > 0 && ticks < 100000) {
+      loop.Tick();
+      EXPECT_LE(previous - loop.speed(), limits.accel);  // never faster than the limit
+      previous = loop.speed();
+      ++ticks;
+    }
+    EXPECT_EQ(loop.speed(), 0u);
+    // One choice a slice: the speed falls by a per slice, so the stop takes
+    // at most that many slices (plus the one under way when it came).
+    EXPECT_LE(ticks, (static_cast<int>(before / limits.accel) + 2) * slice);
+    EXPECT_TRUE(loop.Stopping());
   }
-  EXPECT_EQ(loop.speed(), 0u);
-  EXPECT_LE(ticks, static_cast<int>(before / limits.accel) + 2);
-  EXPECT_TRUE(loop.Stopping());
+}
+
+// A slice changes how often the speed is chosen, never the path: the same
+// entries give the same unit moves in the same order at any slice length,
+// the speed still changes by at most a per tick, the choice runs about once
+// a slice, and the drawing takes about as long (within 1 %).
+TEST(MotionLoop, SlicesChangeOnlyWhenTheSpeedIsChosen) {
+  std::mt19937_64 rng(11);
+  std::vector<std::uint8_t> entries;
+  for (int i = 0; i < 20000; ++i) {
+    if (rng() % 700 == 0) {
+      entries.push_back(MakeEntry(rng() % 2 ? EntryKind::kPenDown : EntryKind::kPenUp));
+      continue;
+    }
+    // Runs of one direction, so that the profile reaches full speed.
+    static std::int32_t delta[2] = {1, 0};
+    if (rng() % 200 == 0) {
+      delta[0] = static_cast<std::int32_t>(rng() % 3) - 1;
+      delta[1] = delta[0] == 0 ? 1 : static_cast<std::int32_t>(rng() % 3) - 1;
+    }
+    entries.push_back(MakeMove(delta, 2));
+  }
+  entries.push_back(MakeEntry(EntryKind::kPenUp));
+  std::vector<std::uint8_t> storage(1024);
+  std::vector<std::pair<std::uint8_t, std::uint8_t>> reference;
+  std::uint64_t reference_ticks = 0;
+  for (const std::uint8_t slice : kSlices) {
+    SCOPED_TRACE(testing::Message() << int{slice} << " ticks a slice");
+    MotionLoop loop(storage.data(), 1024);
+    const motion::TickLimits limits = Limits(8000, 160000, 2, slice);
+    loop.Configure(limits);
+    std::vector<std::pair<std::uint8_t, std::uint8_t>> moves;
+    std::size_t next = 0;
+    std::uint64_t ticks = 0;
+    std::uint32_t speed = 0;
+    while ((next < entries.size() || !loop.Idle()) && ticks < 10'000'000) {
+      while (next < entries.size() && !loop.Full()) ASSERT_TRUE(loop.Push(entries[next++]));
+      const TickOutput out = loop.Tick();
+      // The speed changes by a at most per tick, whatever the slice.
+      const std::uint32_t now = loop.speed();
+      ASSERT_LE(now > speed ? now - speed : speed - now, limits.accel) << ticks;
+      speed = now;
+      if (out.step_mask != 0) moves.emplace_back(out.step_mask, out.negative_mask);
+      if (out.pen != 0) moves.emplace_back(0, out.pen > 0 ? 1 : 2);
+      ++ticks;
+    }
+    ASSERT_TRUE(loop.Idle());
+    // The profile's choice runs about once a slice (one tick slices only
+    // near a stop): 11,515 choices in 179,905 ticks at 16, 44,822 at 4.
+    EXPECT_LE(loop.slices(), ticks / slice * 1.05 + 50);
+    if (slice == 1) {
+      reference = moves;
+      reference_ticks = ticks;
+      continue;
+    }
+    EXPECT_EQ(moves, reference);
+    EXPECT_LE(ticks, reference_ticks * 1.01);
+  }
 }
 
 // --- The path generator --------------------------------------------------

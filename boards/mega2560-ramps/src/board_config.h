@@ -12,6 +12,9 @@
 #ifndef FDSURF_MEGA_TICK_HZ
 #define FDSURF_MEGA_TICK_HZ 2000
 #endif
+#ifndef FDSURF_MEGA_SLICE_TICKS
+#define FDSURF_MEGA_SLICE_TICKS 4
+#endif
 #ifndef FDSURF_MEGA_AXES
 #define FDSURF_MEGA_AXES 2
 #endif
@@ -40,6 +43,13 @@ constexpr uint32_t kTickHz = FDSURF_MEGA_TICK_HZ;
 constexpr uint32_t kTimerClockHz = 16000000ul / 8;
 static_assert(kTickHz >= 1000 && kTickHz <= 40000 && kTimerClockHz % kTickHz == 0,
               "FDSURF_MEGA_TICK_HZ: 1000..40000, dividing 2 MHz");
+
+/// Ticks per slice: the step interrupt runs the motion profile's choice
+/// (64-bit) once a slice and only adds in between (docs/motion.md,
+/// "Slices"); a power of two up to 16.
+constexpr uint8_t kSliceTicks = FDSURF_MEGA_SLICE_TICKS;
+static_assert(kSliceTicks >= 1 && kSliceTicks <= 16 && (kSliceTicks & (kSliceTicks - 1)) == 0,
+              "FDSURF_MEGA_SLICE_TICKS: 1, 2, 4, 8 or 16");
 
 /// 2 (X, Y: a pen plotter) or 3 (X, Y, Z driven by the job, --dims 3).
 constexpr int kAxes = FDSURF_MEGA_AXES;

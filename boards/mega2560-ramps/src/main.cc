@@ -44,7 +44,7 @@ struct Uart0 {
 
 board::ByteRing<kRxRing> g_rx;
 board::UartTransport<board::ByteRing<kRxRing>, Uart0> g_link(g_rx);
-device::Device<kAxes, kQueueCapacity, kLookahead, TickInterruptLock> g_device(kTickHz);
+device::Device<kAxes, kQueueCapacity, kLookahead, TickInterruptLock> g_device(kTickHz, kSliceTicks);
 RampsSteppers g_steppers;
 ServoPen g_pen;
 RampsEndstops g_endstops;

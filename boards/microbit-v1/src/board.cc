@@ -23,6 +23,11 @@
 #ifndef FDSURF_MICROBIT_TICK_HZ
 #define FDSURF_MICROBIT_TICK_HZ 20000
 #endif
+// Ticks per slice: the tick runs the motion profile's choice (64-bit) once
+// a slice and only adds in between (docs/motion.md, "Slices").
+#ifndef FDSURF_MICROBIT_SLICE_TICKS
+#define FDSURF_MICROBIT_SLICE_TICKS 16
+#endif
 // 1: the pen is a hobby servo on edge P1 (the default); 0: a line on P0.
 #ifndef FDSURF_MICROBIT_SERVO
 #define FDSURF_MICROBIT_SERVO 1
@@ -227,7 +232,7 @@ using BoardDevice = device::Device<2, 8, kLookahead, TickLock>;
 constexpr uint16_t kFillBatch = 64;
 
 RxRing g_rx;
-BoardDevice g_device(kTickHz);
+BoardDevice g_device(kTickHz, FDSURF_MICROBIT_SLICE_TICKS);
 PinOutputs g_outputs;
 PinEndstops g_endstops;
 TimerPwm g_servo_pwm(pins::kServo);

@@ -13,6 +13,9 @@
 #ifndef FDSURF_UNO_TICK_HZ
 #define FDSURF_UNO_TICK_HZ 2000
 #endif
+#ifndef FDSURF_UNO_SLICE_TICKS
+#define FDSURF_UNO_SLICE_TICKS 4
+#endif
 #ifndef FDSURF_UNO_SERVO_UP_US
 #define FDSURF_UNO_SERVO_UP_US 1000
 #endif
@@ -35,6 +38,13 @@ constexpr uint32_t kTickHz = FDSURF_UNO_TICK_HZ;
 constexpr uint32_t kTimerClockHz = 16000000ul / 8;
 static_assert(kTickHz >= 1000 && kTickHz <= 40000 && kTimerClockHz % kTickHz == 0,
               "FDSURF_UNO_TICK_HZ: 1000..40000, dividing 2 MHz");
+
+/// Ticks per slice: the step interrupt runs the motion profile's choice
+/// (64-bit) once a slice and only adds in between (docs/motion.md,
+/// "Slices"); a power of two up to 16.
+constexpr uint8_t kSliceTicks = FDSURF_UNO_SLICE_TICKS;
+static_assert(kSliceTicks >= 1 && kSliceTicks <= 16 && (kSliceTicks & (kSliceTicks - 1)) == 0,
+              "FDSURF_UNO_SLICE_TICKS: 1, 2, 4, 8 or 16");
 
 /// X and Y only: the job drives two axes (a pen plotter); the shield's Z
 /// driver shares the enable line but its STEP and DIR stay low.

@@ -45,7 +45,7 @@ struct TickInterruptLock : board::TickInterruptLock {
 board::ByteRing<kRxRing> g_rx;
 device::Device<kAxes, kQueueCapacity, kLookahead, TickInterruptLock,
                protocol::kMaxPreparedFrameBytes, kReplyBytes>
-    g_device(kTickHz);
+    g_device(kTickHz, kSliceTicks);
 ShieldSteppers g_steppers;
 ShieldEndstops g_endstops;
 board::Heartbeat<kHeartbeatTicks> g_heartbeat;

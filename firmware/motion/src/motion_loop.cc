@@ -3,11 +3,27 @@
 
 namespace fdsurf {
 namespace motion {
+namespace {
+
+// log2 of a slice's ticks, or -1 when `slice_ticks` is not a power of two up
+// to kMaxSliceTicks (0 counts as 1).
+int SliceShiftOf(uint8_t slice_ticks) {
+  if (slice_ticks == 0) return 0;
+  for (int shift = 0; (1 << shift) <= kMaxSliceTicks; ++shift) {
+    if (slice_ticks == (1 << shift)) return shift;
+  }
+  return -1;
+}
+
+}  // namespace
+
 bool ToTickLimits(const MotionLimits& limits, TickLimits* out) {
+  const int slice_shift = SliceShiftOf(limits.slice_ticks);
   if (limits.tick_hz == 0 || limits.max_rate == 0 || limits.max_rate > limits.tick_hz ||
-      limits.travel_rate == 0 || limits.travel_rate > limits.tick_hz) {
+      limits.travel_rate == 0 || limits.travel_rate > limits.tick_hz || slice_shift < 0) {
     return false;
   }
+  out->slice_shift = static_cast<uint8_t>(slice_shift);
   const uint64_t hz = limits.tick_hz;
   // Rounded down, so the loop never exceeds the configured figures.
   const uint64_t max_speed = (static_cast<uint64_t>(limits.max_rate) << kLengthFracBits) / hz;
@@ -63,6 +79,8 @@ void MotionLoop::Configure(const TickLimits& limits) {
       limits.max_speed > limits.travel_speed ? limits.max_speed : limits.travel_speed;
   caps_.Configure(limits.turn_budget, limits.accel, top, limits.turn_skip);
   head_start_ = 0;
+  const uint64_t ticks = uint64_t{1} << limits.slice_shift;
+  ramp_distance_ = static_cast<uint64_t>(limits.accel) * (ticks * (ticks - 1) / 2);
 }
 
 MotionLoop::PreparedEntry MotionLoop::Prepare(uint8_t entry) {
@@ -109,6 +127,9 @@ void MotionLoop::Clear() {
   speed_ = 0;
   braking_ = 0;
   pen_wait_ = 0;
+  slice_left_ = 0;
+  ramp_ = 0;
+  creep_ = 0;
   stopping_ = false;
   pausing_ = false;
   head_start_ = 0;
@@ -119,44 +140,91 @@ void MotionLoop::set_position(const int32_t (&position)[3]) {
   for (int a = 0; a < 3; ++a) position_[a] = position[a];
 }
 
-// Longer than the project's 80 lines on purpose: this runs once per step
-// tick (40 kHz on the simulator), and the profile's phases (pen wait, next
-// entry, accelerate / cruise / brake, the step itself) read as one sequence
-// whose order the proof in docs/motion.md follows; split into calls, an MCU
-// pays for each on every tick.
-TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
-  TickOutput out = {0, 0, 0, 0};
-  if (pen_wait_ > 0) {
-    --pen_wait_;
-    return out;
+// The slice's start and choice are called from Tick() alone, once each: in
+// one frame with it, an AVR's step interrupt takes 35 bytes less stack (the
+// Uno keeps 160 B clear of its static RAM).
+#if defined(__GNUC__)
+#define FDSURF_IN_TICK inline __attribute__((always_inline))
+#else
+#define FDSURF_IN_TICK inline
+#endif
+
+FDSURF_IN_TICK uint8_t MotionLoop::ChooseSlice(bool braking) {
+  // Where the loop must be able to stop: the next pen event or the end of
+  // the buffer, or the end of the moves whose turn caps are final; and what
+  // the caps allow (docs/motion.md, "Each axis on curves").
+  const uint64_t position = head_start_ + phase_;
+  const TurnCaps::Bounds caps = caps_.At(position);
+  const uint64_t caps_left = caps.limit > position ? caps.limit - position : 0;
+  const uint64_t stop_left = distance_ - phase_;
+  const uint64_t available = caps_left < stop_left ? caps_left : stop_left;
+  const uint32_t a = limits_.accel;
+  const uint32_t v = speed_;
+  // Pen down: drawing speed; pen up: travel speed. pen_down_ changes only
+  // where a pen event is passed, at rest, so the profile starts from v = 0
+  // under the new limit and every bound in docs/motion.md holds per run.
+  const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
+  creep_ = 0;
+  // A slice of S ticks takes the speeds v + a, …, v + S·a (accelerating) or
+  // v each (cruising); either is taken only if its last tick keeps the rule
+  // v' + B(v') ≤ D, D the distance left before that tick: then every tick
+  // of the slice keeps it (docs/motion.md, "Slices"). Accelerating, that is
+  // B + 2·S·v + a·S² ≤ D (what the first S − 1 ticks cover plus the last
+  // speed and its braking distance B + S·v + a·S(S − 1)/2); cruising,
+  // B + S·v ≤ D. The board's slice first, then a single tick: near a stop
+  // the profile is the per-tick one. S·v and S·a fit in 32 bits (v ≤ 2^24,
+  // S ≤ 16), which keeps an AVR's stack small.
+  for (uint8_t shift = limits_.slice_shift;; shift = 0) {
+    const uint32_t slice_v = v << shift;
+    const uint32_t slice_a = a << shift;
+    const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;  // a·S(S−1)/2
+    if (!braking && v + slice_a <= limit &&
+        braking_ + 2 * static_cast<uint64_t>(slice_v) + slice_a + 2 * ramp <= available &&
+        braking_ + slice_v + ramp <= caps.braking) {
+      ramp_ = 1;
+      braking_ += slice_v + ramp;
+      return shift;
+    }
+    if (!braking && v >= a && v <= limit && braking_ + slice_v <= available &&
+        braking_ <= caps.braking) {
+      ramp_ = 0;
+      return shift;
+    }
+    if (shift == 0) break;
   }
+  if (v > a) {
+    // Braking by a a tick, for a whole slice while the speed allows it:
+    // B(v − S·a) = B(v) − (S·v − S·a − a·S(S − 1)/2).
+    ramp_ = -1;
+    const uint8_t shift = v >= (a << limits_.slice_shift) ? limits_.slice_shift : 0;
+    const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;
+    braking_ -= ((v - a) << shift) - ramp;
+    return shift;
+  }
+  // At rest or at a (never braking here: Tick() ends a stop or pause at a),
+  // with less than a to go (else a single tick would accelerate or cruise):
+  // cover it exactly in one tick, a speed below a.
+  ramp_ = 0;
+  braking_ = 0;
+  speed_ = 0;
+  creep_ = static_cast<uint32_t>(available);
+  return 0;
+}
+
+FDSURF_IN_TICK bool MotionLoop::StartSlice(TickOutput* out) {
   // Held at a pause: nothing is passed, not even a pen event at the head.
-  if (pausing_ && speed_ == 0) return out;
-  // Entries that are not moves are passed at rest (pen events) or on the fly
-  // (command boundaries).
+  if (pausing_ && speed_ == 0) return false;
+  // Entries that are not moves are passed at rest (pen events) or on the
+  // fly (command boundaries).
   while (count_ > 0 && KindOf(At(0)) != EntryKind::kMove) {
     const EntryKind kind = KindOf(At(0));
     Pop();
     if (kind == EntryKind::kCommandDone) {
-      ++out.commands_done;
+      ++out->commands_done;
       continue;
     }
-    // A pen event is only reached with no distance left before it, where the
-    // profile guarantees speed ≤ a; stopping from there is one deceleration.
-    // The run after this pen event becomes the head run.
-    --stops_;
-    speed_ = 0;
-    braking_ = 0;
-    phase_ = 0;
-    distance_ = runs_[first_run_];
-    first_run_ = static_cast<uint8_t>((first_run_ + 1) % kMaxPenEvents);
-    const bool down = kind == EntryKind::kPenDown;
-    if (down != pen_down_) {
-      pen_down_ = down;
-      out.pen = down ? 1 : -1;
-      pen_wait_ = limits_.pen_delay_ticks;
-    }
-    return out;
+    PassPenEvent(kind == EntryKind::kPenDown, out);
+    return false;
   }
   const bool braking = stopping_ || pausing_;
   if (braking && speed_ <= limits_.accel) {
@@ -167,46 +235,49 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     speed_ = 0;
     braking_ = 0;
     if (pausing_) phase_ = 0;
-    return out;
+    return false;
   }
   if (count_ == 0) {
     speed_ = 0;
     braking_ = 0;
+    return false;
+  }
+  slice_left_ = static_cast<uint8_t>(1u << ChooseSlice(braking));
+  ++slices_;
+  return true;
+}
+
+TickOutput MotionLoop::Tick() {
+  TickOutput out = {0, 0, 0, 0};
+  if (pen_wait_ > 0) {
+    --pen_wait_;
     return out;
   }
-
-  // Where the loop must be able to stop: the next pen event or the end of
-  // the buffer, or the end of the moves whose turn caps are final; and what
-  // the caps allow (docs/motion.md, "Each axis on curves").
-  const uint64_t position = head_start_ + phase_;
-  const TurnCaps::Bounds caps = caps_.At(position);
-  const uint64_t caps_left = caps.limit > position ? caps.limit - position : 0;
-  const uint64_t stop_left = distance_ - phase_;
-  const uint64_t available = caps_left < stop_left ? caps_left : stop_left;
+  if (slice_left_ == 0) {
+    if (!StartSlice(&out)) return out;
+  } else {
+    while (count_ > 0 && KindOf(At(0)) == EntryKind::kCommandDone) {
+      Pop();
+      ++out.commands_done;
+    }
+    // A slice that accelerates or cruises ends short of the next pen event
+    // and of the end of the buffer (ChooseSlice()); one that brakes may
+    // reach them at rest before its last tick, and ends there.
+    if (count_ == 0 || KindOf(At(0)) != EntryKind::kMove) {
+      slice_left_ = 0;
+      return out;
+    }
+  }
+  // The tick itself: the speed changes by at most a, then the position
+  // advances by it (or by a creep).
+  --slice_left_;
   const uint32_t a = limits_.accel;
-  const uint64_t v = speed_;
-  // Pen down: drawing speed; pen up: travel speed. pen_down_ changes only
-  // where a pen event is passed, at rest, so the profile starts from v = 0
-  // under the new limit and every bound in docs/motion.md holds per run.
-  const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
-  uint64_t advance = 0;
-  if (!braking && v + a <= limit && (v + a) + braking_ + v <= available &&
-      braking_ + v <= caps.braking) {
-    braking_ += v;  // B(n+1) = B(n) + n·a
+  if (ramp_ > 0) {
     speed_ += a;
-    advance = speed_;
-  } else if (!braking && v + braking_ <= available && v <= limit && braking_ <= caps.braking) {
-    advance = v;
-  } else if (v >= a) {
+  } else if (ramp_ < 0 && speed_ >= a) {
     speed_ -= a;
-    braking_ -= speed_;  // B(n−1) = B(n) − (n−1)·a
-    advance = speed_;
   }
-  if (speed_ == 0 && !braking) {
-    // At rest with less than one acceleration step to go: cover it exactly.
-    advance = available < a ? available : 0;
-  }
-  phase_ += static_cast<uint32_t>(advance);
+  phase_ += speed_ + creep_;
   const uint8_t head = At(0);
   const uint32_t length = LengthOfMove(head);
   if (phase_ >= length) {
@@ -226,6 +297,23 @@ TickOutput MotionLoop::Tick() {  // NOLINT(readability-function-size)
     }
   }
   return out;
+}
+
+void MotionLoop::PassPenEvent(bool down, TickOutput* out) {
+  // A pen event is only reached with no distance left before it, where the
+  // profile guarantees speed ≤ a; stopping from there is one deceleration.
+  // The run after this pen event becomes the head run.
+  --stops_;
+  speed_ = 0;
+  braking_ = 0;
+  phase_ = 0;
+  distance_ = runs_[first_run_];
+  first_run_ = static_cast<uint8_t>((first_run_ + 1) % kMaxPenEvents);
+  if (down != pen_down_) {
+    pen_down_ = down;
+    out->pen = down ? 1 : -1;
+    pen_wait_ = limits_.pen_delay_ticks;
+  }
 }
 
 }  // namespace motion

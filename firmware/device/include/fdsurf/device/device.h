@@ -75,13 +75,15 @@ struct SingleThreadLock {
   SingleThreadLock() {}  // NOLINT(modernize-use-equals-default)
 };
 
-/// A CONFIG's limits as the motion loop takes them at `tick_hz` (the axis
-/// limits of the axes it configures; the others 0). The host works out what
-/// a device will do with its CONFIG by the same conversion.
-inline motion::MotionLimits MotionLimitsOf(const protocol::MachineConfig& config,
-                                           uint32_t tick_hz) {
+/// A CONFIG's limits as the motion loop takes them at `tick_hz` and
+/// `slice_ticks` ticks per slice (MotionLimits; the axis limits of the axes
+/// it configures, the others 0). The host works out what a device will do
+/// with its CONFIG by the same conversion.
+inline motion::MotionLimits MotionLimitsOf(const protocol::MachineConfig& config, uint32_t tick_hz,
+                                           uint8_t slice_ticks = 1) {
   motion::MotionLimits limits{
-      tick_hz, config.max_rate, config.accel, config.pen_delay_ms, config.travel_rate, {0, 0, 0}};
+      tick_hz,   config.max_rate, config.accel, config.pen_delay_ms, config.travel_rate,
+      {0, 0, 0}, slice_ticks};
   for (int a = 0; a < config.axes && a < protocol::kMaxAxes && a < 3; ++a) {
     limits.axis_accel[a] = config.axis_accel[a];
   }
@@ -112,9 +114,12 @@ class Device {
   static_assert(kLookahead >= 2 && kLookahead <= 32768 && (kLookahead & (kLookahead - 1)) == 0,
                 "the lookahead is a power of two");
 
-  /// `tick_hz`: how often the caller will call Tick().
-  explicit Device(uint32_t tick_hz)
-      : tick_hz_(tick_hz), link_(this), motion_(lookahead_, kLookahead) {
+  /// `tick_hz`: how often the caller will call Tick(). `slice_ticks`: how
+  /// many ticks share one choice of speed (a power of two up to
+  /// motion::kMaxSliceTicks; MotionLimits::slice_ticks): 1 chooses it on
+  /// every tick; an MCU whose step interrupt must be short takes more.
+  explicit Device(uint32_t tick_hz, uint8_t slice_ticks = 1)
+      : tick_hz_(tick_hz), slice_ticks_(slice_ticks), link_(this), motion_(lookahead_, kLookahead) {
     ResetState();
   }
   Device(const Device&) = delete;
@@ -442,7 +447,7 @@ class Device {
 
  private:
   FDSURF_NODISCARD motion::MotionLimits LimitsOf(const protocol::MachineConfig& config) const {
-    return MotionLimitsOf(config, tick_hz_);
+    return MotionLimitsOf(config, tick_hz_, slice_ticks_);
   }
 
   // Each used axis's acceleration limit must exceed the path's at this tick
@@ -904,6 +909,7 @@ class Device {
   enum class PausePhase : uint8_t { kNone, kBraking, kLifting, kHeld, kLowering };
 
   uint32_t tick_hz_;
+  uint8_t slice_ticks_;
   protocol::DeviceLink<Device, kReplyBytes, kFrameBytes> link_;
   uint8_t lookahead_[kLookahead];
   motion::MotionLoop motion_;

@@ -52,7 +52,16 @@ struct MotionLimits {
   /// part on curves included; above `accel` (what is left over makes the
   /// turn budget), or 0: the axis is not limited beyond the path's `accel`.
   uint32_t axis_accel[3];
+  /// Ticks per *slice*, the period at which the loop chooses whether to
+  /// accelerate, cruise or brake (a power of two, 1..kMaxSliceTicks; 0
+  /// counts as 1). Between two choices a tick only adds and steps, so an
+  /// MCU's step interrupt pays for the 64-bit profile once per slice
+  /// (docs/motion.md, "Slices").
+  uint8_t slice_ticks;
 };
+
+/// The most ticks per slice (TickLimits::slice_shift ≤ 4).
+constexpr uint8_t kMaxSliceTicks = 16;
 
 /// The same limits per tick, as the loop uses them.
 struct TickLimits {
@@ -71,12 +80,15 @@ struct TickLimits {
   uint32_t turn_budget;
   /// TurnCaps::SkipThresholds() of the budget and the larger speed limit.
   uint32_t turn_skip[TurnCaps::kChords];
+  /// log2 of MotionLimits::slice_ticks, 0..4.
+  uint8_t slice_shift;
 };
 
 /// Converts limits to per-tick units. Returns false when they cannot be
-/// served: max_rate or travel_rate of 0 or above tick_hz, an acceleration
-/// below 2^-24 steps per tick² (too small to represent at this tick rate) or
-/// above either speed limit per tick, or an axis limit (not 0) that does not
+/// served: max_rate or travel_rate of 0 or above tick_hz, slice_ticks not a
+/// power of two up to kMaxSliceTicks, an acceleration below 2^-24 steps per
+/// tick² (too small to represent at this tick rate) or above either speed
+/// limit per tick, or an axis limit (not 0) that does not
 /// exceed the path's acceleration per tick (AxisLimitServable()). Built
 /// without turn caps (FDSURF_DEVICE_TURN_CAPS=0), it lowers both speed
 /// limits to TurnCaps::TopSpeedNoChordBinds() of the turn budget, and
@@ -169,10 +181,15 @@ class MotionLoop {
   FDSURF_NODISCARD bool Empty() const { return count_ == 0; }
   FDSURF_NODISCARD uint16_t Count() const { return count_; }
   /// At rest, not waiting for the pen, nothing buffered.
-  FDSURF_NODISCARD bool Idle() const { return count_ == 0 && speed_ == 0 && pen_wait_ == 0; }
+  FDSURF_NODISCARD bool Idle() const {
+    return count_ == 0 && speed_ == 0 && pen_wait_ == 0 && slice_left_ == 0;
+  }
 
-  /// Advances one tick: updates the speed, executes at most one unit move or
-  /// one pen change, and reports what to output.
+  /// Advances one tick: at the start of a slice chooses whether the slice's
+  /// ticks accelerate, cruise or brake (the 64-bit profile), then changes
+  /// the speed by at most a, advances by it, executes at most one unit move
+  /// or one pen change, and reports what to output. Inside a slice a tick is
+  /// a few 32-bit additions.
   TickOutput Tick();
 
   /// Decelerates to rest along the buffered path as fast as the limits
@@ -194,7 +211,9 @@ class MotionLoop {
   void Resume() { pausing_ = false; }
   FDSURF_NODISCARD bool Pausing() const { return pausing_; }
   /// Paused and at rest: nothing moves until Resume().
-  FDSURF_NODISCARD bool HeldAtPause() const { return pausing_ && speed_ == 0 && pen_wait_ == 0; }
+  FDSURF_NODISCARD bool HeldAtPause() const {
+    return pausing_ && speed_ == 0 && pen_wait_ == 0 && slice_left_ == 0;
+  }
 
   /// Forgets the buffer and the motion state (the caller has made sure the
   /// machine is at rest). Position and counters are kept.
@@ -207,10 +226,24 @@ class MotionLoop {
   FDSURF_NODISCARD uint32_t speed() const { return speed_; }
   /// Unit moves executed since construction (wraps).
   FDSURF_NODISCARD uint32_t moves() const { return moves_; }
+  /// Slices begun since construction (wraps): the ticks that ran the
+  /// profile's choice (ChooseSlice()).
+  FDSURF_NODISCARD uint32_t slices() const { return slices_; }
 
  private:
   FDSURF_NODISCARD uint8_t At(uint16_t offset) const { return storage_[(head_ + offset) & mask_]; }
   void Pop();
+  /// What the first tick of a slice does before it moves: passes the
+  /// entries that are not moves (a pen event at rest ends the tick), ends a
+  /// stop or pause at rest, and chooses the slice. false: the tick does not
+  /// move.
+  bool StartSlice(TickOutput* out);
+  /// The profile's choice at the start of a slice (docs/motion.md,
+  /// "Slices"): sets ramp_ (or a creep) and braking_ as of the slice's end;
+  /// returns log2 of the slice's ticks (the board's slice, or one tick).
+  uint8_t ChooseSlice(bool braking);
+  /// Passes the pen event at the head (popped), at rest.
+  void PassPenEvent(bool down, TickOutput* out);
 
   uint8_t* storage_;
   uint16_t capacity_;
@@ -232,13 +265,24 @@ class MotionLoop {
   /// Distance needed to come to rest from speed_: a·n(n−1)/2.
   uint64_t braking_ = 0;
   uint32_t pen_wait_ = 0;
-  TickLimits limits_ = {0, 1, 0, 0, 0, {0, 0, 0, 0}};
+  /// Ticks of the current slice still to run, and what each does to the
+  /// speed: +1 adds a, 0 keeps it, -1 takes a off (down to rest).
+  uint8_t slice_left_ = 0;
+  int8_t ramp_ = 0;
+  /// A creep from rest (speed 0) over the distance left, less than a, in a
+  /// slice of one tick; else 0.
+  uint32_t creep_ = 0;
+  /// a·S(S−1)/2 for the slice's S ticks: what a slice's ramp adds to the
+  /// distance beyond S times its first speed (set by Configure()).
+  uint64_t ramp_distance_ = 0;
+  TickLimits limits_ = {0, 1, 0, 0, 0, {0, 0, 0, 0}, 0};
   /// Path coordinate (2^-24 steps since Clear()) where the head move starts;
   /// the loop is at head_start_ + phase_.
   uint64_t head_start_ = 0;
   TurnCaps caps_;
   int32_t position_[3] = {0, 0, 0};
   uint32_t moves_ = 0;
+  uint32_t slices_ = 0;
   bool pen_down_ = false;
   bool stopping_ = false;
   bool pausing_ = false;
