@@ -146,25 +146,36 @@ TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
   pushed_end_ += length;
   // No axis limit: nothing to measure, and no move needs to wait.
   if (!limited_) return Final{length, 0, false, false};
-  const uint8_t slot = static_cast<uint8_t>((newest_ + 1) % kHistory);
+  static_assert((kHistory & (kHistory - 1)) == 0, "the history ring is indexed by a mask");
+  constexpr uint8_t kSlotMask = kHistory - 1;
+  const uint8_t slot = static_cast<uint8_t>((newest_ + 1) & kSlotMask);
   if (in_window_ > 0) newest_ = slot;
   const uint16_t n = static_cast<uint16_t>(in_window_ + 1);  // moves in the window with this one
+  // The moves 4, 8, …, 2·kMaxChord back: chord k's middle is 4·2^k back and
+  // the one leaving its `behind` 8·2^k back, chord k + 1's middle. Each is
+  // decoded once (its steps and length; 0 where the window does not reach
+  // it), not once per chord and axis: this runs for every unit move, and on
+  // an AVR the per-chord decoding was a fifth of the main loop.
+  int8_t steps[kChords + 1][3];
+  uint32_t lengths[kChords + 1];
+  for (int j = 0; j <= kChords; ++j) {
+    const uint16_t back = static_cast<uint16_t>(4u << j);
+    // (For 2·kMaxChord back, the slot this move takes: written below.)
+    const uint8_t old = history_[(newest_ + kHistory - back) & kSlotMask];
+    const bool reached = n > back;
+    for (int axis = 0; axis < 3; ++axis) steps[j][axis] = reached ? StepOf(old, axis) : 0;
+    lengths[j] = reached ? LengthOfMove(old) : 0;
+  }
+  int8_t in[3];
+  for (int axis = 0; axis < 3; ++axis) in[axis] = StepOf(move, axis);
   for (int k = 0; k < kChords; ++k) {
-    const uint16_t m = static_cast<uint16_t>(4u << k);
-    // The move leaving `ahead` for `behind`, and the one leaving `behind`.
-    // (For m = kMaxChord, 2m back is the slot this move takes: it is
-    // written after the loop.)
-    const uint8_t middle = history_[(newest_ + kHistory - m) % kHistory];
-    const uint8_t gone = history_[(newest_ + kHistory - 2 * m) % kHistory];
     for (int axis = 0; axis < 3; ++axis) {
-      const int8_t in = StepOf(move, axis);
-      const int8_t mid = n > m ? StepOf(middle, axis) : 0;
-      const int8_t out = n > 2 * m ? StepOf(gone, axis) : 0;
-      ahead_[k][axis] = static_cast<int8_t>(ahead_[k][axis] + in - mid);
-      behind_[k][axis] = static_cast<int8_t>(behind_[k][axis] + mid - out);
+      ahead_[k][axis] = static_cast<int8_t>(ahead_[k][axis] + in[axis] - steps[k][axis]);
+      behind_[k][axis] =
+          static_cast<int8_t>(behind_[k][axis] + steps[k][axis] - steps[k + 1][axis]);
     }
-    ahead_length_[k] += length - (n > m ? LengthOfMove(middle) : 0);
-    behind_length_[k] += (n > m ? LengthOfMove(middle) : 0) - (n > 2 * m ? LengthOfMove(gone) : 0);
+    ahead_length_[k] += length - lengths[k];
+    behind_length_[k] += lengths[k] - lengths[k + 1];
   }
   history_[newest_] = move;
   pending_cap_[newest_] = kNoCap;
@@ -182,13 +193,13 @@ TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
     const uint8_t cap = CapOf(k, turn, shorter);
     if (cap == kNoCap) continue;
     for (uint16_t back = 0; back < 2 * m; ++back) {
-      uint8_t& slot_cap = pending_cap_[(newest_ + kHistory - back) % kHistory];
+      uint8_t& slot_cap = pending_cap_[(newest_ + kHistory - back) & kSlotMask];
       if (cap < slot_cap) slot_cap = cap;
     }
   }
   // The move kPendingMoves back is covered by no chord still to come.
   if (n <= kPendingMoves) return Final{0, 0, false, false};
-  const uint8_t final_slot = static_cast<uint8_t>((newest_ + kHistory - kPendingMoves) % kHistory);
+  const uint8_t final_slot = static_cast<uint8_t>((newest_ + kHistory - kPendingMoves) & kSlotMask);
   return FinalOf(LengthOfMove(history_[final_slot]), pending_cap_[final_slot], false);
 }
 
