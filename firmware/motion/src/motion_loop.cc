@@ -171,21 +171,26 @@ FDSURF_IN_TICK uint8_t MotionLoop::ChooseSlice(bool braking) {
   // of the slice keeps it (docs/motion.md, "Slices"). Accelerating, that is
   // B + 2·S·v + a·S² ≤ D (what the first S − 1 ticks cover plus the last
   // speed and its braking distance B + S·v + a·S(S − 1)/2); cruising,
-  // B + S·v ≤ D. The board's slice first, then a single tick: near a stop
-  // the profile is the per-tick one. S·v and S·a fit in 32 bits (v ≤ 2^24,
-  // S ≤ 16), which keeps an AVR's stack small.
+  // B + S·v ≤ D. S·v and S·a fit in 32 bits (v ≤ 2^24, S ≤ 16), which
+  // keeps an AVR's stack small.
+  // Accelerating is tried first, for the board's slice and then for one
+  // tick (the slice may overshoot the speed limit, or end too close to a
+  // stop, where a tick does not), then cruising the same way: the per-tick
+  // rule's order, so the profile is the per-tick one where slices do not fit.
   for (uint8_t shift = limits_.slice_shift;; shift = 0) {
     const uint32_t slice_v = v << shift;
-    const uint32_t slice_a = a << shift;
     const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;  // a·S(S−1)/2
-    if (!braking && v + slice_a <= limit &&
-        braking_ + 2 * static_cast<uint64_t>(slice_v) + slice_a + 2 * ramp <= available &&
+    if (!braking && v + (a << shift) <= limit &&
+        braking_ + 2 * static_cast<uint64_t>(slice_v) + (a << shift) + 2 * ramp <= available &&
         braking_ + slice_v + ramp <= caps.braking) {
       ramp_ = 1;
       braking_ += slice_v + ramp;
       return shift;
     }
-    if (!braking && v >= a && v <= limit && braking_ + slice_v <= available &&
+    if (shift == 0) break;
+  }
+  for (uint8_t shift = limits_.slice_shift;; shift = 0) {
+    if (!braking && v >= a && v <= limit && braking_ + (v << shift) <= available &&
         braking_ <= caps.braking) {
       ramp_ = 0;
       return shift;
