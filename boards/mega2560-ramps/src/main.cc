@@ -37,9 +37,20 @@ struct TickInterruptLock : board::TickInterruptLock {
   TickInterruptLock() {}  // NOLINT(modernize-use-equals-default): const objects
 };
 
-/// UART0 for the transport (board::SendUart0: polled).
+board::ByteRing<kTxRing> g_tx;
+
+/// UART0 for the transport: replies go into g_tx, and the data-register-
+/// empty interrupt sends them (it turns itself off when the ring is empty;
+/// a send turns it on again).
 struct Uart0 {
-  static void Send(const uint8_t* data, size_t size) { board::SendUart0(data, size); }
+  static void Send(const uint8_t* data, size_t size) {
+    for (size_t i = 0; i < size; ++i) {
+      while (g_tx.Size() == kTxRing) {
+      }
+      (void)g_tx.Push(data[i]);
+      UCSR0B |= _BV(UDRIE0);
+    }
+  }
 };
 
 board::ByteRing<kRxRing> g_rx;
@@ -97,8 +108,19 @@ ISR(TIMER1_OVF_vect) { fdsurf::mega::g_pen.OnPeriodStart(); }
 
 ISR(USART0_RX_vect) { (void)fdsurf::mega::g_rx.Push(UDR0); }
 
+ISR(USART0_UDRE_vect) {
+  uint8_t byte = 0;
+  if (fdsurf::mega::g_tx.Pop(&byte)) {
+    UDR0 = byte;
+  } else {
+    UCSR0B &= static_cast<uint8_t>(~_BV(UDRIE0));
+  }
+}
+
 ISR(TIMER3_COMPA_vect) {
   using namespace fdsurf::mega;
+  // What the previous tick stepped, a whole tick after its pulse.
+  g_steppers.EmitStep();
   // A failed output faults the device, which reports it in STATUS.
   (void)g_device.Tick(g_steppers, g_pen);
   g_heartbeat.OnTick();

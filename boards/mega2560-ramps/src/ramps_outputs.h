@@ -11,6 +11,14 @@
 // Every call here runs in the step timer's interrupt (Device::Tick), the
 // only writer of these ports after SetSafeOutputs(), so the read-modify-
 // writes of PORTF/PORTL/PORTK need no further locking.
+//
+// STEP pulses go out one tick late: Step() records the axes and
+// EmitStep(), first thing in the next tick's interrupt, pulses them. The
+// tick's work takes from ~400 to ~4,400 cycles (the motion profile's choice
+// runs once a slice, docs/motion.md), and a pulse at the end of it would
+// move by that much from tick to tick (two moves 244 µs apart at 2 kHz);
+// from the interrupt's start every pulse is a whole tick after the last.
+// DIR is written when asked, a tick before its pulse.
 #pragma once
 
 #include <avr/io.h>
@@ -33,8 +41,27 @@ class RampsSteppers final : public hal::StepDirOutputs {
   RampsSteppers() : hal::StepDirOutputs(static_cast<uint8_t>(kAxes)) {}
   ~RampsSteppers() = default;
 
+  /// Pulses the axes the previous tick asked to step (none: nothing). Call
+  /// first thing in the step interrupt. X and Y step on the same port, so
+  /// their pulses start and end together.
+  void EmitStep() {
+    if (pending_ == 0) return;
+    uint8_t f = 0;
+    if ((pending_ & 1u) != 0) f |= _BV(PF0);
+    if ((pending_ & 2u) != 0) f |= _BV(PF6);
+    const bool z = kAxes == 3 && (pending_ & 4u) != 0;
+    pending_ = 0;
+    PORTF |= f;
+    if (z) PORTL |= _BV(PL3);
+    __builtin_avr_delay_cycles(kStepHighCycles);
+    PORTF &= static_cast<uint8_t>(~f);
+    if (z) PORTL &= static_cast<uint8_t>(~_BV(PL3));
+  }
+
  private:
   hal::IoStatus DoSetEnabled(bool enabled) override {
+    // A pulse still to go is sent while the driver is enabled.
+    if (!enabled) EmitStep();
     if (enabled) {
       PORTD &= static_cast<uint8_t>(~_BV(PD7));
       PORTF &= static_cast<uint8_t>(~_BV(PF2));
@@ -64,22 +91,17 @@ class RampsSteppers final : public hal::StepDirOutputs {
     return hal::IoStatus::kOk;
   }
 
-  // X and Y step on the same port, so their pulses start and end together.
+  // Recorded for EmitStep() in the next tick (at most one move a tick).
   hal::IoStatus DoStep(uint8_t axis_mask) override {
     if ((axis_mask & ~axis_bits()) != 0) return hal::IoStatus::kInvalidArgument;
-    uint8_t f = 0;
-    if ((axis_mask & 1u) != 0) f |= _BV(PF0);
-    if ((axis_mask & 2u) != 0) f |= _BV(PF6);
-    const bool z = kAxes == 3 && (axis_mask & 4u) != 0;
-    PORTF |= f;
-    if (z) PORTL |= _BV(PL3);
-    __builtin_avr_delay_cycles(kStepHighCycles);
-    PORTF &= static_cast<uint8_t>(~f);
-    if (z) PORTL &= static_cast<uint8_t>(~_BV(PL3));
+    pending_ = static_cast<uint8_t>(pending_ | axis_mask);
     return hal::IoStatus::kOk;
   }
 
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
+
+  /// The axes to pulse at the next tick's start.
+  uint8_t pending_ = 0;
 };
 
 /// The pen as a hobby servo on OC1A: Timer1 in fast PWM (mode 14, TOP =

@@ -118,6 +118,8 @@ ISR(USART_RX_vect) {
 
 ISR(TIMER1_COMPA_vect) {
   using namespace fdsurf::uno;
+  // What the previous tick stepped, a whole tick after its pulse.
+  g_steppers.EmitStep();
   // A failed output faults the device, which reports it in STATUS.
   (void)g_device.Tick(g_steppers, g_pen);
   g_heartbeat.OnTick();

@@ -13,6 +13,13 @@
 // only writer of PORTD and of PB0 after SetSafeOutputs(); the servo's
 // interrupt writes no port (its pin is Timer2's OC2A), so the read-modify-
 // writes need no further locking.
+//
+// STEP pulses go out one tick late: Step() records the axes and
+// EmitStep(), first thing in the next tick's interrupt, pulses them, so
+// every pulse is a whole tick after the last however long the tick's work
+// (the motion profile's choice runs once a slice; boards/mega2560-ramps's
+// ramps_outputs.h measured the difference). DIR is written when asked, a
+// tick before its pulse.
 #pragma once
 
 #include <avr/io.h>
@@ -34,8 +41,24 @@ class ShieldSteppers final : public hal::StepDirOutputs {
   ShieldSteppers() : hal::StepDirOutputs(static_cast<uint8_t>(kAxes)) {}
   ~ShieldSteppers() = default;
 
+  /// Pulses the axes the previous tick asked to step (none: nothing). Call
+  /// first thing in the step interrupt. X and Y step on the same port, so
+  /// their pulses start and end together.
+  void EmitStep() {
+    if (pending_ == 0) return;
+    uint8_t d = 0;
+    if ((pending_ & 1u) != 0) d |= _BV(PD2);
+    if ((pending_ & 2u) != 0) d |= _BV(PD3);
+    pending_ = 0;
+    PORTD |= d;
+    __builtin_avr_delay_cycles(kStepHighCycles);
+    PORTD &= static_cast<uint8_t>(~d);
+  }
+
  private:
   hal::IoStatus DoSetEnabled(bool enabled) override {
+    // A pulse still to go is sent while the drivers are enabled.
+    if (!enabled) EmitStep();
     if (enabled) {
       PORTB &= static_cast<uint8_t>(~_BV(PB0));
     } else {
@@ -54,19 +77,17 @@ class ShieldSteppers final : public hal::StepDirOutputs {
     return hal::IoStatus::kOk;
   }
 
-  // X and Y step on the same port, so their pulses start and end together.
+  // Recorded for EmitStep() in the next tick (at most one move a tick).
   hal::IoStatus DoStep(uint8_t axis_mask) override {
     if ((axis_mask & ~axis_bits()) != 0) return hal::IoStatus::kInvalidArgument;
-    uint8_t d = 0;
-    if ((axis_mask & 1u) != 0) d |= _BV(PD2);
-    if ((axis_mask & 2u) != 0) d |= _BV(PD3);
-    PORTD |= d;
-    __builtin_avr_delay_cycles(kStepHighCycles);
-    PORTD &= static_cast<uint8_t>(~d);
+    pending_ = static_cast<uint8_t>(pending_ | axis_mask);
     return hal::IoStatus::kOk;
   }
 
   FDSURF_NODISCARD const char* DoLastError() const override { return ""; }
+
+  /// The axes to pulse at the next tick's start.
+  uint8_t pending_ = 0;
 };
 
 }  // namespace uno
