@@ -289,7 +289,7 @@ TEST(MotionLoop, StopDeceleratesAlongThePathWithinTheLimit) {
 // A slice changes how often the speed is chosen, never the path: the same
 // entries give the same unit moves in the same order at any slice length,
 // the speed still changes by at most a per tick, the choice runs about once
-// a slice, and the drawing takes about as long (within 1 %).
+// a slice, and the drawing takes about as long (within 2 %).
 TEST(MotionLoop, SlicesChangeOnlyWhenTheSpeedIsChosen) {
   std::mt19937_64 rng(11);
   std::vector<std::uint8_t> entries;
@@ -309,23 +309,32 @@ TEST(MotionLoop, SlicesChangeOnlyWhenTheSpeedIsChosen) {
   entries.push_back(MakeEntry(EntryKind::kPenUp));
   std::vector<std::uint8_t> storage(1024);
   // The simulated plotter's tick and speed (the top speed 2000 accelerations
-  // a tick), and an Uno's (2 kHz, the top speed it keeps without turn caps:
-  // 7.6 accelerations a tick, where a slice of acceleration overshoots it).
+  // a tick), the same with turn caps (axis limits twice the path's: the
+  // profile then follows the end of the moves whose caps are final), and an
+  // Uno's (2 kHz, the top speed it keeps without turn caps: 7.6
+  // accelerations a tick, where a slice of acceleration overshoots it).
   struct Machine {
     std::uint32_t tick_hz;
     std::uint32_t max_rate;
+    std::uint32_t axis_accel;
   };
-  for (const Machine machine : {Machine{kTickHz, 8000}, Machine{2000, 607}}) {
+  for (const Machine machine :
+       {Machine{kTickHz, 8000, 0}, Machine{kTickHz, 8000, 320000}, Machine{2000, 607, 0}}) {
     std::vector<std::pair<std::uint8_t, std::uint8_t>> reference;
     std::uint64_t reference_ticks = 0;
     for (const std::uint8_t slice : kSlices) {
-      SCOPED_TRACE(testing::Message()
-                   << machine.tick_hz << " Hz, " << int{slice} << " ticks a slice");
+      SCOPED_TRACE(testing::Message() << machine.tick_hz << " Hz, axes " << machine.axis_accel
+                                      << ", " << int{slice} << " ticks a slice");
       MotionLoop loop(storage.data(), 1024);
       motion::TickLimits limits{};
-      ASSERT_TRUE(motion::ToTickLimits(
-          {machine.tick_hz, machine.max_rate, 160000, 2, machine.max_rate, {0, 0, 0}, slice},
-          &limits));
+      ASSERT_TRUE(motion::ToTickLimits({machine.tick_hz,
+                                        machine.max_rate,
+                                        160000,
+                                        2,
+                                        machine.max_rate,
+                                        {machine.axis_accel, machine.axis_accel, 0},
+                                        slice},
+                                       &limits));
       loop.Configure(limits);
       std::vector<std::pair<std::uint8_t, std::uint8_t>> moves;
       std::size_t next = 0;
@@ -343,17 +352,19 @@ TEST(MotionLoop, SlicesChangeOnlyWhenTheSpeedIsChosen) {
         ++ticks;
       }
       ASSERT_TRUE(loop.Idle());
-      // The profile's choice runs about once a slice (one-tick slices only
-      // near a stop and the top speed): 11,556 choices in 179,901 ticks at
-      // 40 kHz and 16, 6,053 in 87,041 at 2 kHz and 16.
-      EXPECT_LE(loop.slices(), ticks / slice * 1.2 + 50);
+      // The profile's choice runs about once a slice (one-tick slices near
+      // a stop, the top speed and a cap): at 16, 11,556 choices in 179,901
+      // ticks; with turn caps 26,999 in 360,314 (34,710 when a tick of
+      // acceleration comes before a slice of cruising); at 2 kHz 6,053 in
+      // 87,041.
+      EXPECT_LE(loop.slices(), ticks / slice * 1.25 + 50);
       if (slice == 1) {
         reference = moves;
         reference_ticks = ticks;
         continue;
       }
       EXPECT_EQ(moves, reference);
-      EXPECT_LE(ticks, reference_ticks * 1.01);
+      EXPECT_LE(ticks, reference_ticks * 1.02);
     }
   }
 }

@@ -57,7 +57,7 @@ struct MotionLimits {
   /// counts as 1). Between two choices a tick only adds and steps, so an
   /// MCU's step interrupt pays for the 64-bit profile once per slice
   /// (docs/motion.md, "Slices").
-  uint8_t slice_ticks;
+  uint8_t slice_ticks = 1;
 };
 
 /// The most ticks per slice (TickLimits::slice_shift ≤ 4).
