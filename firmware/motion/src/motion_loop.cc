@@ -149,6 +149,29 @@ void MotionLoop::set_position(const int32_t (&position)[3]) {
 #define FDSURF_IN_TICK inline
 #endif
 
+// Whether a slice of 2^shift ticks may accelerate: v + S·a ≤ v_max,
+// B + 2·S·v + a·S² ≤ D and B(v + S·a) = B + S·v + a·S(S − 1)/2 ≤ B_c.
+FDSURF_IN_TICK bool MotionLoop::Accelerates(uint8_t shift, uint64_t available,
+                                            uint64_t caps_braking) const {
+  const uint32_t a = limits_.accel;
+  const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
+  if (speed_ + (a << shift) > limit) return false;
+  const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;  // a·S(S − 1)/2
+  const uint64_t then_braking = braking_ + (speed_ << shift) + ramp;
+  // B + 2·S·v + a·S² = B(v + S·a) + S·v + S·a + a·S(S − 1)/2.
+  return then_braking <= caps_braking &&
+         then_braking + (speed_ << shift) + (a << shift) + ramp <= available;
+}
+
+// Whether a slice of 2^shift ticks may cruise: a ≤ v ≤ v_max, B + S·v ≤ D
+// and B ≤ B_c.
+FDSURF_IN_TICK bool MotionLoop::Cruises(uint8_t shift, uint64_t available,
+                                        uint64_t caps_braking) const {
+  const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
+  return speed_ >= limits_.accel && speed_ <= limit && braking_ <= caps_braking &&
+         braking_ + (speed_ << shift) <= available;
+}
+
 FDSURF_IN_TICK uint8_t MotionLoop::ChooseSlice(bool braking) {
   // Where the loop must be able to stop: the next pen event or the end of
   // the buffer, or the end of the moves whose turn caps are final; and what
@@ -182,26 +205,28 @@ FDSURF_IN_TICK uint8_t MotionLoop::ChooseSlice(bool braking) {
   // the caps (else a profile that follows a stop point moving ahead, the end
   // of the final caps, chose on every tick); a tick of acceleration comes
   // first where it fails only on the limit (else the speed stayed up to S·a
-  // below it: an Uno at 2 kHz cruised at 4·a of its 7.6·a). One copy of
-  // the test for all five keeps an AVR's flash and stack small.
+  // below it: an Uno at 2 kHz cruised at 4·a of its 7.6·a).
   const uint8_t slice = limits_.slice_shift;
-  for (uint8_t attempt = 0; attempt < 5 && !braking; ++attempt) {
-    if (attempt == 1 && v + (a << slice) <= limit) continue;
-    const uint8_t shift = attempt == 0 || attempt == 2 ? slice : 0;
-    const bool accelerate = attempt != 2 && attempt != 4;
-    const uint32_t slice_v = v << shift;
-    const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;  // a·S(S−1)/2
-    // Accelerating: v + S·a ≤ v_max, B + 2·S·v + a·S² ≤ D and
-    // B(v + S·a) = B + S·v + a·S(S − 1)/2 ≤ B_c; cruising: a ≤ v ≤ v_max,
-    // B + S·v ≤ D and B ≤ B_c.
-    const bool within = accelerate ? v + (a << shift) <= limit : v >= a && v <= limit;
-    const uint64_t needed =
-        accelerate ? braking_ + 2 * static_cast<uint64_t>(slice_v) + (a << shift) + 2 * ramp
-                   : braking_ + slice_v;
-    const uint64_t then_braking = accelerate ? braking_ + slice_v + ramp : braking_;
-    if (within && needed <= available && then_braking <= caps.braking) {
-      ramp_ = accelerate ? 1 : 0;
-      braking_ = then_braking;
+  if (!braking) {
+    uint8_t shift = slice;
+    if (!Accelerates(shift, available, caps.braking)) {
+      shift = 0;
+      if (v + (a << slice) <= limit || !Accelerates(0, available, caps.braking)) {
+        shift = 0xFF;
+      }
+    }
+    if (shift == 0xFF) {
+      ramp_ = 0;
+      if (Cruises(slice, available, caps.braking)) return slice;
+      if (Accelerates(0, available, caps.braking)) {
+        shift = 0;
+      } else if (Cruises(0, available, caps.braking)) {
+        return 0;
+      }
+    }
+    if (shift != 0xFF) {
+      ramp_ = 1;
+      braking_ += (v << shift) + (shift == 0 ? 0 : ramp_distance_);
       return shift;
     }
   }

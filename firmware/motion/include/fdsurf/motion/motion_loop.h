@@ -242,6 +242,10 @@ class MotionLoop {
   /// "Slices"): sets ramp_ (or a creep) and braking_ as of the slice's end;
   /// returns log2 of the slice's ticks (the board's slice, or one tick).
   uint8_t ChooseSlice(bool braking);
+  /// The tests of ChooseSlice() for a slice of 2^shift ticks, with D =
+  /// `available` and B_c = `caps_braking` (docs/motion.md, "Slices").
+  FDSURF_NODISCARD bool Accelerates(uint8_t shift, uint64_t available, uint64_t caps_braking) const;
+  FDSURF_NODISCARD bool Cruises(uint8_t shift, uint64_t available, uint64_t caps_braking) const;
   /// Passes the pen event at the head (popped), at rest.
   void PassPenEvent(bool down, TickOutput* out);
 
