@@ -21,7 +21,7 @@
 #include "servo_pwm.h"
 
 #ifndef FDSURF_MICROBIT_TICK_HZ
-#define FDSURF_MICROBIT_TICK_HZ 20000
+#define FDSURF_MICROBIT_TICK_HZ 12500
 #endif
 // Ticks per slice: the tick runs the motion profile's choice (64-bit) once
 // a slice and only adds in between (docs/motion.md, "Slices").

@@ -245,7 +245,8 @@ class MotionLoop {
   /// The tests of ChooseSlice() for a slice of 2^shift ticks, with D =
   /// `available` and B_c = `caps_braking` (docs/motion.md, "Slices").
   FDSURF_NODISCARD bool Accelerates(uint8_t shift, uint64_t available, uint64_t caps_braking) const;
-  FDSURF_NODISCARD bool Cruises(uint8_t shift, uint64_t available, uint64_t caps_braking) const;
+  FDSURF_NODISCARD bool HasRoom(uint8_t shift, uint64_t available, uint64_t caps_braking) const;
+  uint8_t Accelerate(uint8_t shift);
   /// Passes the pen event at the head (popped), at rest.
   void PassPenEvent(bool down, TickOutput* out);
 
