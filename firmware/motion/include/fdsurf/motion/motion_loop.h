@@ -17,6 +17,9 @@
 // end of what is buffered): v' + B(v') ≤ distance available. If v was
 // feasible on the previous tick, v − a is feasible now, so the loop can always
 // stop in time; it never needs to know the future beyond its buffer.
+// The choice is made once per slice of S ticks (MotionLimits::slice_ticks)
+// and held over them, tested on the slice's last tick, which then keeps the
+// rule on every tick of it; the ticks in between only add.
 // With axis limits, speed caps on curves (TurnCaps) are points and stretches
 // of the path with a braking bound of their own, kept the same way.
 // docs/motion.md gives the proof and the units.
