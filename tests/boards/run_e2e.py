@@ -347,7 +347,12 @@ def stream(args, processes, board, link, duration_s):
     with open(processes.log_path("fdsurf"), "w") as log:
         process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT,
                                    preexec_fn=die_with_parent)
-        time.sleep(args.stop_after_s if args.stop_after_s else 2 + duration_s * 0.4)
+        # A quarter of the way in (the host needs about a second to connect):
+        # a STOP that comes before the first move still passes (the recording
+        # must be a proper prefix, or nothing), one after the last fails, and
+        # a board that draws faster than the simulated plotter's machine time
+        # (the micro:bit under QEMU, with slices) had finished at 2 + 0.4 x.
+        time.sleep(args.stop_after_s if args.stop_after_s else 1 + duration_s * 0.25)
         if process.poll() is not None:
             raise Failure("fdsurf finished (exit %d) before the STOP" % process.returncode)
         process.send_signal(signal.SIGINT)
