@@ -170,11 +170,17 @@ BOARDS = {
     "microbit-v1": {"baud": 115200, "min_pulse_ns": 1000, "min_dir_setup_ns": 200,
                     "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
                     "limits": MICROBIT_LIMITS,
+                    # QEMU runs the M0 two to three times faster than real
+                    # time once it has booted: the STOP a tenth of the way in
+                    # by the machine time (at a quarter it came with 2.9 of the
+                    # job's 3.0 s drawn).
+                    "stop_fraction": 0.1,
                     "job_args": "--fit 40x30 --lines 2 "
                                 "--servo-pulse-up 1200 --servo-pulse-down 1800"},
-    # 3 lines each way: 5.3 s, so that the STOP (2 s + 40 % of the job after
-    # the start) falls well inside it (2 lines took 3.0 s once the device
-    # stepped chords, and the STOP came after the end).
+    # 3 lines each way: 5.3 s, so that the STOP (1 s + a quarter of the job
+    # after the start) falls well inside it (2 lines took 3.0 s once the
+    # device stepped chords, and the STOP, then at 2 s + 40 %, came after the
+    # end).
     "standin": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
                 "servo_us": None, "limits": None, "job_args": "--fit 40x30 --lines 3"},
 }
@@ -347,12 +353,13 @@ def stream(args, processes, board, link, duration_s):
     with open(processes.log_path("fdsurf"), "w") as log:
         process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT,
                                    preexec_fn=die_with_parent)
-        # A quarter of the way in (the host needs about a second to connect):
-        # a STOP that comes before the first move still passes (the recording
-        # must be a proper prefix, or nothing), one after the last fails, and
-        # a board that draws faster than the simulated plotter's machine time
-        # (the micro:bit under QEMU, with slices) had finished at 2 + 0.4 x.
-        time.sleep(args.stop_after_s if args.stop_after_s else 1 + duration_s * 0.25)
+        # A quarter of the way in by the machine time (the host needs about a
+        # second to connect; a board's "stop_fraction" says otherwise): a
+        # STOP that comes before the first move still passes (the recording
+        # must be a proper prefix, or nothing), one after the last fails. At
+        # 2 s + 40 % the micro:bit, faster with slices, had once finished.
+        fraction = board.get("stop_fraction", 0.25)
+        time.sleep(args.stop_after_s if args.stop_after_s else 1 + duration_s * fraction)
         if process.poll() is not None:
             raise Failure("fdsurf finished (exit %d) before the STOP" % process.returncode)
         process.send_signal(signal.SIGINT)
