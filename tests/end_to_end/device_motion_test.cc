@@ -84,12 +84,17 @@ double IdealSeconds(double distance, double speed, double accel) {
 
 TEST(MotionLimits, RefusesWhatTheLoopCannotServe) {
   motion::TickLimits limits{};
-  EXPECT_FALSE(
-      motion::ToTickLimits({kTickHz, kTickHz + 1, 1000, 0, 1000}, &limits));  // > 1 step/tick
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 0, 1000, 0, 1000}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kTickHz + 1, 1000, 0, 1000, {0, 0, 0}, 1},
+                                    &limits));  // > 1 step/tick
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 0, 1000, 0, 1000, {0, 0, 0}, 1}, &limits));
   // 10 steps/s² at 40 kHz is 10·2^24/1.6e9 ≈ 0.1 units per tick²: not representable.
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 1000, 10, 0, 1000}, &limits));
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 1000, 10, 0, 1000, {0, 0, 0}, 1}, &limits));
+  // A slice is a power of two of ticks up to kMaxSliceTicks (0 counts as 1).
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000, {0, 0, 0}, 3}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000, {0, 0, 0}, 32}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000, {0, 0, 0}, 0}, &limits));
+  EXPECT_EQ(limits.slice_shift, 0u);
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 100, 8000, {0, 0, 0}, 1}, &limits));
   EXPECT_EQ(limits.max_speed, 3355443u);  // 8000·2^24/40000, rounded down
   EXPECT_EQ(limits.accel, 1677u);         // 160000·2^24/40000², rounded down
   EXPECT_EQ(limits.pen_delay_ticks, 4000u);

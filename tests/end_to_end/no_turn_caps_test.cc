@@ -33,20 +33,21 @@ TEST(NoTurnCaps, ToTickLimitsLowersBothSpeedsToWhereNoChordBinds) {
   // At 40 kHz: a = 1677 and a budget of ⌊√(3355² − 1677²)⌋ = 2905 (the
   // capped test's figures); ⌊√(2905·2^26/3)⌋ = 254 919, 2^-24 steps per
   // tick: 607.8 steps/s instead of 8000.
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 6000, {320000, 640000, 0}}, &limits));
+  ASSERT_TRUE(
+      motion::ToTickLimits({kTickHz, 8000, 160000, 0, 6000, {320000, 640000, 0}, 1}, &limits));
   EXPECT_EQ(limits.turn_budget, 2905u);
   EXPECT_EQ(limits.max_speed, 254919u);
   EXPECT_EQ(limits.travel_speed, 254919u);
   // Slower than the bound, or no axis limit: the speeds are the configured
   // ones.
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 500, 16000, 0, 400, {320000, 640000, 0}}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 500, 16000, 0, 400, {320000, 640000, 0}, 1}, &limits));
   EXPECT_EQ(limits.max_speed, (500ull << 24) / kTickHz);
   EXPECT_EQ(limits.travel_speed, (400ull << 24) / kTickHz);
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {0, 0, 0}}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {0, 0, 0}, 1}, &limits));
   EXPECT_EQ(limits.max_speed, (8000ull << 24) / kTickHz);
   // An axis limit so close to the path's that the bound is below one
   // acceleration step: refused.
-  EXPECT_FALSE(motion::ToTickLimits({1000, 1000, 999000, 0, 1000, {999999, 0, 0}}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({1000, 1000, 999000, 0, 1000, {999999, 0, 0}, 1}, &limits));
 }
 
 TEST(NoTurnCaps, RandomStrokesKeepEveryAxisWithinItsLimit) {

@@ -31,7 +31,8 @@ struct Recording {
 // The loop is fed as a producer would, whenever it has room.
 Recording RunThreeStrokes() {
   motion::TickLimits limits{};
-  EXPECT_TRUE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 10, kTravelRate}, &limits));
+  EXPECT_TRUE(
+      motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 10, kTravelRate, {0, 0, 0}, 1}, &limits));
   EXPECT_EQ(limits.max_speed, 1677721u);     // 4000·2^24/40000, rounded down
   EXPECT_EQ(limits.travel_speed, 3355443u);  // 8000·2^24/40000, rounded down
   std::vector<std::uint8_t> storage(1024);
@@ -100,11 +101,13 @@ TEST(TravelSpeed, TheCheckHoldsPenUpRunsToTheirOwnLimit) {
 
 TEST(TravelSpeed, ToTickLimitsRefusesATravelRateTheLoopCannotServe) {
   motion::TickLimits limits{};
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, kTickHz + 1}, &limits));
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, 0}, &limits));
+  EXPECT_FALSE(
+      motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, kTickHz + 1, {0, 0, 0}, 1}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, 0, {0, 0, 0}, 1}, &limits));
   // accel above the travel speed per tick (a·1 tick > v_max): refused as for max_rate.
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, 1}, &limits));
-  EXPECT_TRUE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, kTickHz}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, 1, {0, 0, 0}, 1}, &limits));
+  EXPECT_TRUE(
+      motion::ToTickLimits({kTickHz, kDrawRate, kAccel, 0, kTickHz, {0, 0, 0}, 1}, &limits));
   EXPECT_EQ(limits.travel_speed, 1u << 24);  // one unit move per tick
 }
 

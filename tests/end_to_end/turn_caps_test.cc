@@ -217,13 +217,14 @@ TEST(TurnCaps, ToTickLimitsGivesTheBudgetOfTheSmallestAxis) {
   motion::TickLimits limits{};
   // At 40 kHz: a = ⌊160000·2^24/1.6e9⌋ = 1677, A = ⌊320000·2^24/1.6e9⌋ =
   // 3355 on X and 6710 on Y: the budget is ⌊√(3355² − 1677²)⌋ = 2905.
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {320000, 640000, 0}}, &limits));
+  ASSERT_TRUE(
+      motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {320000, 640000, 0}, 1}, &limits));
   EXPECT_EQ(limits.accel, 1677u);
   EXPECT_EQ(limits.turn_budget, 2905u);
   // No axis limit, no budget; an axis limit not above the path's: refused.
-  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {0, 0, 0}}, &limits));
+  ASSERT_TRUE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {0, 0, 0}, 1}, &limits));
   EXPECT_EQ(limits.turn_budget, 0u);
-  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {160000, 0, 0}}, &limits));
+  EXPECT_FALSE(motion::ToTickLimits({kTickHz, 8000, 160000, 0, 8000, {160000, 0, 0}, 1}, &limits));
 }
 
 }  // namespace

@@ -31,8 +31,8 @@ struct Machine {
 
 inline motion::TickLimits TickLimitsOf(const Machine& m) {
   motion::TickLimits limits{};
-  const motion::MotionLimits si{kTickHz, m.rate, m.accel,
-                                0,       m.rate, {m.axis_accel, m.axis_accel, 0}};
+  const motion::MotionLimits si{
+      kTickHz, m.rate, m.accel, 0, m.rate, {m.axis_accel, m.axis_accel, 0}, 1};
   EXPECT_TRUE(motion::ToTickLimits(si, &limits));
   return limits;
 }

@@ -80,7 +80,7 @@ void MotionLoop::Configure(const TickLimits& limits) {
   caps_.Configure(limits.turn_budget, limits.accel, top, limits.turn_skip);
   head_start_ = 0;
   const uint64_t ticks = uint64_t{1} << limits.slice_shift;
-  ramp_distance_ = static_cast<uint64_t>(limits.accel) * (ticks * (ticks - 1) / 2);
+  ramp_distance_ = static_cast<uint32_t>(limits.accel * (ticks * (ticks - 1) / 2));
 }
 
 MotionLoop::PreparedEntry MotionLoop::Prepare(uint8_t entry) {
@@ -156,11 +156,13 @@ FDSURF_IN_TICK bool MotionLoop::Accelerates(uint8_t shift, uint64_t available,
   const uint32_t a = limits_.accel;
   const uint32_t limit = pen_down_ ? limits_.max_speed : limits_.travel_speed;
   if (speed_ + (a << shift) > limit) return false;
-  const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;  // a·S(S − 1)/2
-  const uint64_t then_braking = braking_ + (speed_ << shift) + ramp;
-  // B + 2·S·v + a·S² = B(v + S·a) + S·v + S·a + a·S(S − 1)/2.
-  return then_braking <= caps_braking &&
-         then_braking + (speed_ << shift) + (a << shift) + ramp <= available;
+  // S·v + a·S(S − 1)/2 and S·v + S·a + a·S(S − 1)/2 in 32 bits (below
+  // 2^29 + 2^28 + 2^31): B(v + S·a) = B + the first, and
+  // B + 2·S·v + a·S² = B(v + S·a) + the second.
+  const uint32_t ramp = shift == 0 ? 0 : ramp_distance_;
+  const uint32_t to_braking = (speed_ << shift) + ramp;
+  const uint64_t then_braking = braking_ + to_braking;
+  return then_braking <= caps_braking && then_braking + (to_braking + (a << shift)) <= available;
 }
 
 // Whether a slice of 2^shift ticks has room to cruise: B + S·v ≤ D and
@@ -238,7 +240,7 @@ FDSURF_IN_TICK uint8_t MotionLoop::ChooseSlice(bool braking) {
     // B(v − S·a) = B(v) − (S·v − S·a − a·S(S − 1)/2).
     ramp_ = -1;
     const uint8_t shift = v >= (a << limits_.slice_shift) ? limits_.slice_shift : 0;
-    const uint64_t ramp = shift == 0 ? 0 : ramp_distance_;
+    const uint32_t ramp = shift == 0 ? 0 : ramp_distance_;
     braking_ -= ((v - a) << shift) - ramp;
     return shift;
   }

@@ -60,7 +60,7 @@ struct MotionLimits {
   /// counts as 1). Between two choices a tick only adds and steps, so an
   /// MCU's step interrupt pays for the 64-bit profile once per slice
   /// (docs/motion.md, "Slices").
-  uint8_t slice_ticks = 1;
+  uint8_t slice_ticks;
 };
 
 /// The most ticks per slice (TickLimits::slice_shift ≤ 4).
@@ -281,8 +281,9 @@ class MotionLoop {
   /// slice of one tick; else 0.
   uint32_t creep_ = 0;
   /// a·S(S−1)/2 for the slice's S ticks: what a slice's ramp adds to the
-  /// distance beyond S times its first speed (set by Configure()).
-  uint64_t ramp_distance_ = 0;
+  /// distance beyond S times its first speed (set by Configure(); below
+  /// 120·2^24, as a ≤ 2^24 and S ≤ 16).
+  uint32_t ramp_distance_ = 0;
   TickLimits limits_ = {0, 1, 0, 0, 0, {0, 0, 0, 0}, 0};
   /// Path coordinate (2^-24 steps since Clear()) where the head move starts;
   /// the loop is at head_start_ + phase_.
