@@ -40,11 +40,28 @@ namespace fdsurf {
 namespace motion {
 namespace {
 
-// The step of axis `axis` in a unit move: −1, 0 or +1.
-int8_t StepOf(uint8_t move, int axis) {
-  const uint8_t bits = static_cast<uint8_t>(move >> (2 * axis));
+// The step of a unit move on the axis whose two bits `bits` are (bit 0: it
+// steps, bit 1: towards negative): −1, 0 or +1. The caller shifts by a
+// constant: on an AVR a shift by a variable count is a loop.
+int8_t StepOfBits(uint8_t bits) {
   if ((bits & 1) == 0) return 0;
   return (bits & 2) != 0 ? -1 : 1;
+}
+
+// The turn of a chord beyond what rounding can make on each axis
+// (`rounding`), doubled: for e1 ≥ e2 ≥ e3 ≥ 0, e1 + (e2 + e3)/2 ≥
+// √(e1² + e2² + e3²) (as e1·(e2 + e3) ≥ e2² + e3²), so 2·e1 + e2 + e3
+// bounds twice the Euclidean norm of that vector in integers.
+uint16_t DoubledTurn(const int8_t (&turn)[3], int8_t rounding) {
+  uint8_t largest = 0;
+  uint16_t sum = 0;
+  for (const int8_t axis_turn : turn) {
+    const int8_t magnitude = axis_turn < 0 ? static_cast<int8_t>(-axis_turn) : axis_turn;
+    const uint8_t excess = magnitude > rounding ? static_cast<uint8_t>(magnitude - rounding) : 0;
+    sum = static_cast<uint16_t>(sum + excess);
+    if (excess > largest) largest = excess;
+  }
+  return static_cast<uint16_t>(largest + sum);  // ≤ 4·64
 }
 
 // B_c/a rounded down to three significant bits, as a one-byte code that
@@ -85,7 +102,15 @@ void TurnCaps::Configure(uint32_t turn_budget, uint32_t accel, uint32_t top_spee
   top_speed_ = top_speed;
   budget_ = turn_budget;
   limited_ = turn_budget != 0;
-  for (int k = 0; k < kChords; ++k) skip_[k] = skip[k];
+  binding_chords_ = 0;
+  for (int k = 0; k < kChords; ++k) {
+    // A doubled turn is at most 4·(2m − rounding) (|d| ≤ 2m on each axis):
+    // a chord whose threshold is at or above that never binds, and is not
+    // measured at all; 16 bits hold every threshold that matters.
+    skip_[k] = skip[k] > 0xFFFFu ? 0xFFFFu : static_cast<uint16_t>(skip[k]);
+    const uint32_t most = 4u * ((8u << k) - static_cast<uint32_t>(RoundingOf(k)));
+    if (skip[k] < most) binding_chords_ = static_cast<uint8_t>(binding_chords_ | (1u << k));
+  }
   Clear();
 }
 
@@ -100,33 +125,13 @@ void TurnCaps::Clear() {
 
 void TurnCaps::ResetWindow() {
   in_window_ = 0;
-  newest_ = 0;
-  for (int k = 0; k < kChords; ++k) {
-    for (int axis = 0; axis < 3; ++axis) {
-      ahead_[k][axis] = 0;
-      behind_[k][axis] = 0;
-    }
-    ahead_length_[k] = 0;
-    behind_length_[k] = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    position_[axis] = 0;
+    positions_[newest_][axis] = 0;  // the window's start, before its first move
   }
 }
 
-uint8_t TurnCaps::CapOf(int chord, const int8_t (&turn)[3], uint32_t length) const {
-  // Per axis, the turn beyond what rounding can make (the longest chord
-  // counts all of it), then a bound on the Euclidean norm of that vector:
-  // for e1 ≥ e2 ≥ e3 ≥ 0, e1 + (e2 + e3)/2 ≥ √(e1² + e2² + e3²) (as
-  // e1·(e2 + e3) ≥ e2² + e3²); doubled, to stay in integers.
-  const int rounding = chord == kChords - 1 ? 0 : kRoundingTurn;
-  uint32_t largest = 0;
-  uint32_t sum = 0;
-  for (const int8_t axis_turn : turn) {
-    const int magnitude = axis_turn < 0 ? -axis_turn : axis_turn;
-    const uint32_t excess = magnitude > rounding ? static_cast<uint32_t>(magnitude - rounding) : 0;
-    sum += excess;
-    if (excess > largest) largest = excess;
-  }
-  const uint32_t doubled_turn = largest + sum;  // 2·e1 + e2 + e3
-  if (doubled_turn <= skip_[chord]) return kNoCap;
+uint8_t TurnCaps::CapOf(uint32_t doubled_turn, uint32_t length) const {
   // v²·(turn/h²) ≤ budget in steps: v² ≤ 2·budget·(h²/2^24) / doubled_turn,
   // h the shorter half of the chord in 2^-24 steps (≤ 32·√3·2^24 < 2^30, so
   // h²/2^24 < 2^36, and times 2·budget ≤ 2^25 this fits in 64 bits).
@@ -142,61 +147,60 @@ uint8_t TurnCaps::CapOf(int chord, const int8_t (&turn)[3], uint32_t length) con
   return Coarsen(units > 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<uint32_t>(units));
 }
 
+uint32_t TurnCaps::LengthOfMoves(uint16_t back, uint16_t count) const {
+  uint32_t length = 0;  // ≤ 32·√3·2^24 < 2^30
+  for (uint16_t k = 0; k < count; ++k) {
+    length += LengthOfMove(history_[(newest_ + kHistory - back - k) & (kHistory - 1)]);
+  }
+  return length;
+}
+
 TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
   pushed_end_ += length;
   // No axis limit: nothing to measure, and no move needs to wait.
   if (!limited_) return Final{length, 0, false, false};
-  static_assert((kHistory & (kHistory - 1)) == 0, "the history ring is indexed by a mask");
+  static_assert((kHistory & (kHistory - 1)) == 0, "the rings are indexed by a mask");
   constexpr uint8_t kSlotMask = kHistory - 1;
-  const uint8_t slot = static_cast<uint8_t>((newest_ + 1) & kSlotMask);
-  if (in_window_ > 0) newest_ = slot;
+  newest_ = static_cast<uint8_t>((newest_ + 1) & kSlotMask);
   const uint16_t n = static_cast<uint16_t>(in_window_ + 1);  // moves in the window with this one
-  // The moves 4, 8, …, 2·kMaxChord back: chord k's middle is 4·2^k back and
-  // the one leaving its `behind` 8·2^k back, chord k + 1's middle. Each is
-  // decoded once (its steps and length; 0 where the window does not reach
-  // it), not once per chord and axis: this runs for every unit move, and on
-  // an AVR the per-chord decoding was a fifth of the main loop.
-  int8_t steps[kChords + 1][3];
-  uint32_t lengths[kChords + 1];
-  for (int j = 0; j <= kChords; ++j) {
-    const uint16_t back = static_cast<uint16_t>(4u << j);
-    // (For 2·kMaxChord back, the slot this move takes: written below.)
-    const uint8_t old = history_[(newest_ + kHistory - back) & kSlotMask];
-    const bool reached = n > back;
-    for (int axis = 0; axis < 3; ++axis) steps[j][axis] = reached ? StepOf(old, axis) : 0;
-    lengths[j] = reached ? LengthOfMove(old) : 0;
-  }
-  int8_t in[3];
-  for (int axis = 0; axis < 3; ++axis) in[axis] = StepOf(move, axis);
-  for (int k = 0; k < kChords; ++k) {
-    for (int axis = 0; axis < 3; ++axis) {
-      ahead_[k][axis] = static_cast<int8_t>(ahead_[k][axis] + in[axis] - steps[k][axis]);
-      behind_[k][axis] =
-          static_cast<int8_t>(behind_[k][axis] + steps[k][axis] - steps[k + 1][axis]);
-    }
-    ahead_length_[k] += length - lengths[k];
-    behind_length_[k] += lengths[k] - lengths[k + 1];
-  }
+  in_window_ = n > kHistory ? kHistory + 1 : n;
   history_[newest_] = move;
   pending_cap_[newest_] = kNoCap;
-  in_window_ = n > kHistory ? kHistory + 1 : n;
+  // The position after this move (its steps read with constant shifts).
+  int8_t* const position = position_;
+  position[0] = static_cast<int8_t>(position[0] + StepOfBits(move));
+  position[1] = static_cast<int8_t>(position[1] + StepOfBits(static_cast<uint8_t>(move >> 2)));
+  position[2] = static_cast<int8_t>(position[2] + StepOfBits(static_cast<uint8_t>(move >> 4)));
 
-  for (int k = 0; k < kChords; ++k) {
-    const uint16_t m = static_cast<uint16_t>(4u << k);
-    if (n < 2 * m) continue;
-    int8_t turn[3];
-    for (int axis = 0; axis < 3; ++axis) {
-      turn[axis] = static_cast<int8_t>(ahead_[k][axis] - behind_[k][axis]);
-    }
-    const uint32_t shorter =
-        ahead_length_[k] < behind_length_[k] ? ahead_length_[k] : behind_length_[k];
-    const uint8_t cap = CapOf(k, turn, shorter);
+  // Each chord of m moves that the window holds whole and that can bind:
+  // its turn d = p[t] − 2·p[t−m] + p[t−2m]. Most end at the skip threshold,
+  // in 8- and 16-bit arithmetic; the lengths of the halves and the 64-bit
+  // cap only follow where the turn may bind. (m doubles along with k: on
+  // an AVR `4 << k` would be a loop.)
+  uint16_t m = 4;
+  for (int k = 0; k < kChords; ++k, m = static_cast<uint16_t>(m << 1)) {
+    if (n < 2 * m) break;  // nor any longer chord
+    if ((binding_chords_ & (1u << k)) == 0) continue;
+    // For the longest chord p[t−2m] is in this move's slot, not yet overwritten.
+    const int8_t(&middle)[3] = positions_[(newest_ + kHistory - m) & kSlotMask];
+    const int8_t(&start)[3] = positions_[(newest_ + kHistory - 2 * m) & kSlotMask];
+    const int8_t turn[3] = {
+        static_cast<int8_t>(position[0] - 2 * middle[0] + start[0]),
+        static_cast<int8_t>(position[1] - 2 * middle[1] + start[1]),
+        static_cast<int8_t>(position[2] - 2 * middle[2] + start[2]),
+    };
+    const uint16_t doubled_turn = DoubledTurn(turn, RoundingOf(k));
+    if (doubled_turn <= skip_[k]) continue;
+    const uint32_t ahead = LengthOfMoves(0, m);
+    const uint32_t behind = LengthOfMoves(m, m);
+    const uint8_t cap = CapOf(doubled_turn, ahead < behind ? ahead : behind);
     if (cap == kNoCap) continue;
     for (uint16_t back = 0; back < 2 * m; ++back) {
       uint8_t& slot_cap = pending_cap_[(newest_ + kHistory - back) & kSlotMask];
       if (cap < slot_cap) slot_cap = cap;
     }
   }
+  for (int axis = 0; axis < 3; ++axis) positions_[newest_][axis] = position[axis];
   // The move kPendingMoves back is covered by no chord still to come.
   if (n <= kPendingMoves) return Final{0, 0, false, false};
   const uint8_t final_slot = static_cast<uint8_t>((newest_ + kHistory - kPendingMoves) & kSlotMask);

@@ -42,8 +42,9 @@ constexpr int kLengthFracBits = 24;
 /// shorter than it is. (Chosen by comparisons rather than read from a
 /// table: avr-gcc would keep a table in RAM.)
 inline uint32_t LengthOfMove(uint8_t move) {
-  int axes = 0;
-  for (int a = 0; a < 3; ++a) axes += (move >> (2 * a)) & 1;
+  // Constant shifts: on an AVR a shift by a variable count is a loop, and
+  // this runs for every unit move.
+  const uint8_t axes = static_cast<uint8_t>((move & 1) + ((move >> 2) & 1) + ((move >> 4) & 1));
   if (axes == 1) return 16777216u;   // 2^24
   if (axes == 2) return 23726567u;   // ⌈√2·2^24⌉
   return axes == 3 ? 29058991u : 0;  // ⌈√3·2^24⌉

@@ -102,8 +102,8 @@ class TurnCaps {
   // enabled and masks it only for Commit() (a few additions). Every Final
   // is committed before the next measurement.
 
-  /// Measures a unit move `length` long; returns the move that becomes final
-  /// (the one kPendingMoves back, or none yet).
+  /// Measures a unit move, `length` = LengthOfMove(move); returns the move
+  /// that becomes final (the one kPendingMoves back, or none yet).
   Final Measure(uint8_t move, uint32_t length);
   /// Makes every measured move final (the pending ones as one region under
   /// their lowest cap) and starts a new window: no chord spans this point.
@@ -158,9 +158,19 @@ class TurnCaps {
   /// weighs three points 1, 2, 1. The chords shorter than the longest allow
   /// it; the longest does not.
   static constexpr int kRoundingTurn = 2;
+  /// The rounding chord k's turn leaves out on each axis: kRoundingTurn for
+  /// the shorter chords, none for the longest (it counts all of it).
+  static int8_t RoundingOf(int chord) {
+    return chord == kChords - 1 ? 0 : static_cast<int8_t>(kRoundingTurn);
+  }
 
-  /// The cap of one chord (code of B_c/a), or kNoCap.
-  FDSURF_NODISCARD uint8_t CapOf(int chord, const int8_t (&turn)[3], uint32_t length) const;
+  /// The cap (code of B_c/a) of a chord whose doubled turn exceeds its
+  /// skip threshold, `length` its shorter half, or kNoCap (the 64-bit half
+  /// of the test: rarely reached, so out of Measure()'s common path).
+  FDSURF_NODISCARD uint8_t CapOf(uint32_t doubled_turn, uint32_t length) const;
+  /// The length of the `count` moves that end `back` moves before the
+  /// newest (only for a chord past its skip threshold).
+  FDSURF_NODISCARD uint32_t LengthOfMoves(uint16_t back, uint16_t count) const;
   FDSURF_NODISCARD Final FinalOf(uint64_t length, uint8_t cap, bool stop) const;
   void AppendRegion(uint64_t start, uint64_t end, uint64_t braking);
   void Recompute(uint64_t position);
@@ -172,21 +182,29 @@ class TurnCaps {
   uint32_t top_speed_ = 0;
   /// A budget is set; without one every move is final at once.
   bool limited_ = false;
-  /// A chord of kind k binds only if its doubled turn exceeds skip_[k].
-  uint32_t skip_[kChords] = {};
+  /// A chord of kind k binds only if its doubled turn exceeds skip_[k]
+  /// (clamped to 16 bits: a doubled turn is at most 256).
+  uint16_t skip_[kChords] = {};
+  /// Bit k: chord k's threshold is below its largest doubled turn, so it
+  /// may bind; the others are not measured.
+  uint8_t binding_chords_ = 0;
 
   // The window of recent moves (since the last MeasureAll()).
+  /// The moves, and the position after each (per axis, in whole steps
+  /// modulo 256: a chord's turn p[t] − 2·p[t−m] + p[t−2m] is at most 2m ≤ 64
+  /// in magnitude, so it comes out exact in 8-bit arithmetic), in rings
+  /// indexed by a mask. The slot before the window's first move holds its
+  /// start, position 0.
   uint8_t history_[kHistory] = {};
+  int8_t positions_[kHistory][3] = {};
   /// Per pending move, the lowest cap of the chords measured so far.
   uint8_t pending_cap_[kHistory] = {};
+  /// The newest move's slot.
   uint8_t newest_ = 0;
+  /// Moves in the window, counted up to kHistory + 1.
   uint16_t in_window_ = 0;
-  /// Per chord and axis, the sums of the newest m moves (ahead) and of the
-  /// m before them (behind): d = ahead − behind.
-  int8_t ahead_[kChords][3] = {};
-  int8_t behind_[kChords][3] = {};
-  uint32_t ahead_length_[kChords] = {};
-  uint32_t behind_length_[kChords] = {};
+  /// The position after the newest move (modulo 256).
+  int8_t position_[3] = {};
 
   /// Where the measured moves end (the producer's alone) and where the final
   /// ones end (written by Commit(), read by the tick).
