@@ -41,8 +41,8 @@ struct Int128 {
         "st %a[target]+, %[augend]\n\t"
         "dec %[count]\n\t"
         "brne 1b"
-        : [target] "+e"(target), [source] "+e"(source), [count] "+r"(count),
-          [augend] "=&r"(augend), [addend] "=&r"(addend)
+        : [target] "+e"(target), [source] "+e"(source), [count] "+r"(count), [augend] "=&r"(augend),
+          [addend] "=&r"(addend)
         :
         : "memory");
     return *this;
