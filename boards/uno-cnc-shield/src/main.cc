@@ -103,7 +103,7 @@ void SetSafeOutputs() {
 }  // namespace uno
 }  // namespace fdsurf
 
-ISR(TIMER2_COMPA_vect) { fdsurf::uno::g_pen.OnCompare(); }
+ISR(TIMER2_COMPB_vect) { fdsurf::uno::g_pen.OnCompare(); }
 
 // A byte that finds the ring full is lost (the link protocol resends its
 // frame); the count of them, saturating at 255, is kept in GPIOR1, a

@@ -12,12 +12,21 @@
 // steps of 16 us (a 1000..2000 us servo has 63 positions). Both edges come
 // from the timer's hardware: no interrupt latency moves them.
 //
-// The gating runs in TIMER2_COMPA_vect, just after each period's compare
-// match, when the pin is low either way: it connects OC2A for the period
-// that follows (and loads the width the pen wants), or disconnects it (the
-// pin is then PORTB3 = 0). It has until the next BOTTOM, 1.6 ms or more
-// after the compare, to do so; the step interrupt, the longest section
-// with interrupts masked, takes 0.14 ms at most (2 204 cycles measured).
+// The gating runs in TIMER2_COMPB_vect, at count kGateCount of every
+// period (OC2B stays disconnected: PD3 is Y's STEP), after any pulse's
+// compare match, when the pin is low either way: it connects OC2A for the
+// period that follows (and loads the width the pen wants), or disconnects
+// it (the pin is then PORTB3 = 0). It has until the next BOTTOM, 512 us
+// after it, to do so; the step interrupt, the longest section with
+// interrupts masked, takes 0.16 ms at most (2 533 cycles measured).
+//
+// A pen change takes effect at the next pulse that has not begun: one that
+// comes between the gating and that pulse's BOTTOM writes OCR2A itself.
+// The hardware buffers it until BOTTOM; simavr applies it at once, but the
+// count is then past every width's compare, so neither sees a compare
+// ahead in that period. No change waits more than one pulse period,
+// 20.48 ms (24.08 ms when the gating ran at the pulse's compare and such a
+// change waited for the pulse after).
 #pragma once
 
 #include <avr/io.h>
@@ -36,6 +45,9 @@ class ServoPen final : public hal::PenOutput {
   static constexpr uint8_t kPeriodsPerPulse = 5;
   /// One Timer2 count (clock / 256), microseconds.
   static constexpr uint16_t kCountUs = 16;
+  /// OCR2B: where the gating runs, past the longest pulse (2500 us, count
+  /// 156) and 32 counts (512 us) before BOTTOM.
+  static constexpr uint8_t kGateCount = 224;
 
   ServoPen() = default;
   ~ServoPen() = default;
@@ -52,18 +64,19 @@ class ServoPen final : public hal::PenOutput {
     PORTB &= static_cast<uint8_t>(~_BV(PB3));
     DDRB |= _BV(PB3);
     OCR2A = CompareFor(kServoUpUs);
+    OCR2B = kGateCount;
     TCNT2 = 0;
     TCCR2A = _BV(WGM21) | _BV(WGM20);
     TCCR2B = _BV(CS22) | _BV(CS21);
-    TIFR2 = _BV(TOV2) | _BV(OCF2A);
-    TIMSK2 = _BV(OCIE2A);
+    TIFR2 = _BV(TOV2) | _BV(OCF2A) | _BV(OCF2B);
+    TIMSK2 = _BV(OCIE2B);
   }
 
-  /// Call from TIMER2_COMPA_vect.
+  /// Call from TIMER2_COMPB_vect.
   void OnCompare() {
-    // A compare without an overflow since the last one is the same period's
-    // again: simavr re-arms the compare when OCR2A is written mid-period
-    // (the hardware buffers OCR2A until BOTTOM and matches once).
+    // One gating a period: a compare without an overflow since the last one
+    // is the same period's again (TOV2 also tells DoSetPen() whether the
+    // gated pulse has begun).
     if ((TIFR2 & _BV(TOV2)) == 0) return;
     TIFR2 = _BV(TOV2);
     if (++phase_ == kPeriodsPerPulse) phase_ = 0;
@@ -71,9 +84,8 @@ class ServoPen final : public hal::PenOutput {
       TCCR2A = _BV(WGM21) | _BV(WGM20);  // OC2A off: the pin stays low
       return;
     }
-    // The width first, with OC2A still off: simavr applies an OCR2A write
-    // at once, and would set the pin at a compare still ahead in this
-    // period if OC2A were already on.
+    // Past every width's compare: no compare ahead in this period, for
+    // simavr, which applies an OCR2A write at once.
     OCR2A = next_compare_;
     TCCR2A = _BV(COM2A1) | _BV(WGM21) | _BV(WGM20);
   }
@@ -84,6 +96,10 @@ class ServoPen final : public hal::PenOutput {
   hal::IoStatus DoSetPen(bool down) override {
     widths_.set_down(down);
     next_compare_ = CompareFor(widths_.WidthUs());
+    // Gated, and the pulse's BOTTOM not passed yet (it sets TOV2, which
+    // OnCompare() cleared at the gating): this pulse can still carry it.
+    // (The count is past kGateCount, above every width's compare.)
+    if (phase_ == kPeriodsPerPulse - 1 && (TIFR2 & _BV(TOV2)) == 0) OCR2A = next_compare_;
     return hal::IoStatus::kOk;
   }
   // Also from the step interrupt (Device::Tick), before any pen change; the
