@@ -105,14 +105,14 @@ bool MotionLoop::Push(const PreparedEntry& prepared) {
     ++stops_;
   } else if (kind == EntryKind::kMove) {
     uint64_t& run = stops_ == 0 ? distance_ : runs_[(first_run_ + stops_ - 1) % kMaxPenEvents];
-    run += LengthOfMove(entry);
+    AddLength(&run, LengthOfMove(entry));
   }
   caps_.Commit(prepared.final);
   return true;
 }
 
 void MotionLoop::Pop() {
-  if (KindOf(At(0)) == EntryKind::kMove) head_start_ += LengthOfMove(At(0));
+  if (KindOf(At(0)) == EntryKind::kMove) AddLength(&head_start_, LengthOfMove(At(0)));
   head_ = static_cast<uint16_t>((head_ + 1) & mask_);
   --count_;
 }

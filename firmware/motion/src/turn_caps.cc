@@ -156,7 +156,7 @@ uint32_t TurnCaps::LengthOfMoves(uint16_t back, uint16_t count) const {
 }
 
 TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
-  pushed_end_ += length;
+  AddLength(&pushed_end_, length);
   // No axis limit: nothing to measure, and no move needs to wait.
   if (!limited_) return Final{length, 0, false, false};
   static_assert((kHistory & (kHistory - 1)) == 0, "the rings are indexed by a mask");
@@ -216,7 +216,8 @@ TurnCaps::Final TurnCaps::MeasureAll(bool stop) {
     if (cap < lowest) lowest = cap;
   }
   ResetWindow();
-  return FinalOf(pushed_end_ - final_end_, lowest, stop && limited_);
+  // At most kPendingMoves moves: below 63·√3·2^24 < 2^31.
+  return FinalOf(static_cast<uint32_t>(pushed_end_ - final_end_), lowest, stop && limited_);
 }
 
 void TurnCaps::Recompute(uint64_t position) {
@@ -245,7 +246,7 @@ void TurnCaps::Recompute(uint64_t position) {
 
 void TurnCaps::Commit(const Final& final) {
   const uint64_t start = final_end_;
-  final_end_ += final.length;
+  AddLength(&final_end_, final.length);
   if (final.capped && final.length > 0) AppendRegion(start, final_end_, final.braking);
   // One unit of length long, so that it is still in force on the tick after
   // the loop reaches it (HasRoom() beforehand leaves room for both).
@@ -255,7 +256,7 @@ void TurnCaps::Commit(const Final& final) {
   bounds_.limit = final_end_ < next_key_ ? final_end_ : next_key_;
 }
 
-TurnCaps::Final TurnCaps::FinalOf(uint64_t length, uint8_t cap, bool stop) const {
+TurnCaps::Final TurnCaps::FinalOf(uint32_t length, uint8_t cap, bool stop) const {
   if (cap == kNoCap) return Final{length, 0, false, stop};
   uint64_t braking = UnitsOf(cap) * accel_;
   // Region::reach = B_c + a below 2^32: a lower multiple of a (a lower cap).

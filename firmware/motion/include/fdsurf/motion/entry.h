@@ -50,5 +50,39 @@ inline uint32_t LengthOfMove(uint8_t move) {
   return axes == 3 ? 29058991u : 0;  // ⌈√3·2^24⌉
 }
 
+/// *sum += addend, for the path coordinates and distances the loop keeps
+/// in 64 bits and grows by a move's or a run's length at a time. On an AVR
+/// one add-with-carry chain over the sum's bytes: avr-gcc would call
+/// __adddi3 with both operands moved through 16 registers, four times for
+/// every unit move.
+inline void AddLength(uint64_t* sum, uint32_t addend) {
+#if defined(__AVR__)
+  uint8_t* bytes = reinterpret_cast<uint8_t*>(sum);
+  asm volatile(
+      "ld __tmp_reg__, %a[bytes]\n\t"
+      "add __tmp_reg__, %A[addend]\n\t"
+      "st %a[bytes]+, __tmp_reg__\n\t"
+      "ld __tmp_reg__, %a[bytes]\n\t"
+      "adc __tmp_reg__, %B[addend]\n\t"
+      "st %a[bytes]+, __tmp_reg__\n\t"
+      "ld __tmp_reg__, %a[bytes]\n\t"
+      "adc __tmp_reg__, %C[addend]\n\t"
+      "st %a[bytes]+, __tmp_reg__\n\t"
+      "ld __tmp_reg__, %a[bytes]\n\t"
+      "adc __tmp_reg__, %D[addend]\n\t"
+      "st %a[bytes]+, __tmp_reg__\n\t"
+      ".rept 4\n\t"
+      "ld __tmp_reg__, %a[bytes]\n\t"
+      "adc __tmp_reg__, __zero_reg__\n\t"
+      "st %a[bytes]+, __tmp_reg__\n\t"
+      ".endr"
+      : [bytes] "+e"(bytes)
+      : [addend] "r"(addend)
+      : "memory");
+#else
+  *sum += addend;
+#endif
+}
+
 }  // namespace motion
 }  // namespace fdsurf

@@ -91,7 +91,8 @@ class TurnCaps {
   /// multiple of a, worked out when measuring so that the commit only adds),
   /// and with `stop` a stop region at its end.
   struct Final {
-    uint64_t length;
+    /// At most kPendingMoves moves' length (< 2^31).
+    uint32_t length;
     uint64_t braking;
     bool capped;
     bool stop;
@@ -171,7 +172,7 @@ class TurnCaps {
   /// The length of the `count` moves that end `back` moves before the
   /// newest (only for a chord past its skip threshold).
   FDSURF_NODISCARD uint32_t LengthOfMoves(uint16_t back, uint16_t count) const;
-  FDSURF_NODISCARD Final FinalOf(uint64_t length, uint8_t cap, bool stop) const;
+  FDSURF_NODISCARD Final FinalOf(uint32_t length, uint8_t cap, bool stop) const;
   void AppendRegion(uint64_t start, uint64_t end, uint64_t braking);
   void Recompute(uint64_t position);
   void ResetWindow();
@@ -241,7 +242,7 @@ class TurnCaps {
                  const uint32_t (&/*skip*/)[kChords]) {}
   void Clear() {}
   struct Final {
-    uint64_t length;
+    uint32_t length;
     uint64_t braking;
     bool capped;
     bool stop;
