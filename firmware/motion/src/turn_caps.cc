@@ -36,6 +36,10 @@ uint32_t TurnCaps::TopSpeedNoChordBinds(uint32_t turn_budget) {
 
 #if FDSURF_DEVICE_TURN_CAPS
 
+// Measure()'s per-chord work is inlined on every target: avr-gcc at -Os
+// would call it, and pass what are constants as arguments.
+#define FDSURF_CAPS_INLINE inline __attribute__((always_inline))
+
 namespace fdsurf {
 namespace motion {
 namespace {
@@ -155,6 +159,37 @@ uint32_t TurnCaps::LengthOfMoves(uint16_t back, uint16_t count) const {
   return length;
 }
 
+template <int kChord>
+FDSURF_CAPS_INLINE void TurnCaps::MeasureChord() {
+  static_assert(kChord >= 0 && kChord < kChords, "a chord of the four");
+  constexpr uint16_t m = 4u << kChord;
+  constexpr uint8_t kSlotMask = kHistory - 1;
+  if ((binding_chords_ & (1u << kChord)) == 0) return;
+  // Its turn d = p[t] − 2·p[t−m] + p[t−2m]; for the longest chord p[t−2m]
+  // is in the newest move's slot, not yet overwritten.
+  const int8_t(&middle)[3] = positions_[(newest_ + kHistory - m) & kSlotMask];
+  const int8_t(&start)[3] = positions_[(newest_ + kHistory - 2 * m) & kSlotMask];
+  const int8_t turn[3] = {
+      static_cast<int8_t>(position_[0] - 2 * middle[0] + start[0]),
+      static_cast<int8_t>(position_[1] - 2 * middle[1] + start[1]),
+      static_cast<int8_t>(position_[2] - 2 * middle[2] + start[2]),
+  };
+  // Most chords end here, in 8- and 16-bit arithmetic.
+  const uint16_t doubled_turn = DoubledTurn(turn, RoundingOf(kChord));
+  if (doubled_turn > skip_[kChord]) Bind(m, doubled_turn);
+}
+
+void TurnCaps::Bind(uint16_t m, uint16_t doubled_turn) {
+  const uint32_t ahead = LengthOfMoves(0, m);
+  const uint32_t behind = LengthOfMoves(m, m);
+  const uint8_t cap = CapOf(doubled_turn, ahead < behind ? ahead : behind);
+  if (cap == kNoCap) return;
+  for (uint16_t back = 0; back < 2 * m; ++back) {
+    uint8_t& slot_cap = pending_cap_[(newest_ + kHistory - back) & (kHistory - 1)];
+    if (cap < slot_cap) slot_cap = cap;
+  }
+}
+
 TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
   AddLength(&pushed_end_, length);
   // No axis limit: nothing to measure, and no move needs to wait.
@@ -172,32 +207,17 @@ TurnCaps::Final TurnCaps::Measure(uint8_t move, uint32_t length) {
   position[1] = static_cast<int8_t>(position[1] + StepOfBits(static_cast<uint8_t>(move >> 2)));
   position[2] = static_cast<int8_t>(position[2] + StepOfBits(static_cast<uint8_t>(move >> 4)));
 
-  // Each chord of m moves that the window holds whole and that can bind:
-  // its turn d = p[t] − 2·p[t−m] + p[t−2m]. Most end at the skip threshold,
-  // in 8- and 16-bit arithmetic; the lengths of the halves and the 64-bit
-  // cap only follow where the turn may bind. (m doubles along with k: on
-  // an AVR `4 << k` would be a loop.)
-  uint16_t m = 4;
-  for (int k = 0; k < kChords; ++k, m = static_cast<uint16_t>(m << 1)) {
-    if (n < 2 * m) break;  // nor any longer chord
-    if ((binding_chords_ & (1u << k)) == 0) continue;
-    // For the longest chord p[t−2m] is in this move's slot, not yet overwritten.
-    const int8_t(&middle)[3] = positions_[(newest_ + kHistory - m) & kSlotMask];
-    const int8_t(&start)[3] = positions_[(newest_ + kHistory - 2 * m) & kSlotMask];
-    const int8_t turn[3] = {
-        static_cast<int8_t>(position[0] - 2 * middle[0] + start[0]),
-        static_cast<int8_t>(position[1] - 2 * middle[1] + start[1]),
-        static_cast<int8_t>(position[2] - 2 * middle[2] + start[2]),
-    };
-    const uint16_t doubled_turn = DoubledTurn(turn, RoundingOf(k));
-    if (doubled_turn <= skip_[k]) continue;
-    const uint32_t ahead = LengthOfMoves(0, m);
-    const uint32_t behind = LengthOfMoves(m, m);
-    const uint8_t cap = CapOf(doubled_turn, ahead < behind ? ahead : behind);
-    if (cap == kNoCap) continue;
-    for (uint16_t back = 0; back < 2 * m; ++back) {
-      uint8_t& slot_cap = pending_cap_[(newest_ + kHistory - back) & kSlotMask];
-      if (cap < slot_cap) slot_cap = cap;
+  // Each chord of m moves that the window holds whole (none longer when
+  // one is not) and that can bind, with constant m: on an AVR the chord's
+  // indices are then immediate operands.
+  if (n >= 2 * 4) {
+    MeasureChord<0>();
+    if (n >= 2 * 8) {
+      MeasureChord<1>();
+      if (n >= 2 * 16) {
+        MeasureChord<2>();
+        if (n >= 2 * 32) MeasureChord<3>();
+      }
     }
   }
   for (int axis = 0; axis < 3; ++axis) positions_[newest_][axis] = position[axis];

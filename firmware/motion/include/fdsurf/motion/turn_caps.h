@@ -169,6 +169,13 @@ class TurnCaps {
   /// skip threshold, `length` its shorter half, or kNoCap (the 64-bit half
   /// of the test: rarely reached, so out of Measure()'s common path).
   FDSURF_NODISCARD uint8_t CapOf(uint32_t doubled_turn, uint32_t length) const;
+  /// Measures chord kChord (m = 4·2^kChord moves ending at the newest one,
+  /// which the window holds whole) and, past its skip threshold, Bind()s it.
+  template <int kChord>
+  void MeasureChord();
+  /// The cap of a chord of m moves with `doubled_turn`, applied to the 2m
+  /// newest moves' pending caps (the rare half of MeasureChord()).
+  void Bind(uint16_t m, uint16_t doubled_turn);
   /// The length of the `count` moves that end `back` moves before the
   /// newest (only for a chord past its skip threshold).
   FDSURF_NODISCARD uint32_t LengthOfMoves(uint16_t back, uint16_t count) const;
