@@ -156,19 +156,19 @@ BOARDS = {
     # patches, 2 t-lines each, on a 20 x 15 mm page, pen delay 50 ms: 9.7 s
     # of machine time for the simulated plotter; the Uno, without turn caps,
     # runs at 607 steps/s at most and takes about 32 s). A new width goes
-    # out with the next pulse that has not begun: within one pulse period,
-    # 20.48 ms ("servo_wait_ns"; the checker times the change at that pulse
-    # and allows the wait; 24.08 ms before 2026-12-08, when a change after
-    # the gating waited for the pulse after), so the job's pen delay is
-    # longer than that: at 20 ms a first step could come before the pen had
-    # moved, on a real machine too. Its servo (Timer2,
+    # out at the next gating, 512 us before its pulse: within one pulse
+    # period and those 512 us, 20.99 ms ("servo_wait_ns"; the checker times
+    # the change at that pulse and allows the wait; 24.08 ms before
+    # 2026-12-08, when the gating ran at the pulse's compare), so the job's
+    # pen delay is longer than that: at 20 ms a first step could come before
+    # the pen had moved, on a real machine too. Its servo (Timer2,
     # servo_pwm.h) pulses every 20.48 ms in steps of 16 us: 1800 us is made
     # as 1808, so a width within 10 us (half a step, and the 2 us every
     # board is allowed) of the profile's is exact.
     "uno-cnc-shield": {"baud": 115200, "min_pulse_ns": 1900, "min_dir_setup_ns": 650,
                        "servo_us": (1000, 2000), "job_servo_us": (1200, 1800),
                        "servo_period_ns": 20_480_000, "servo_width_slack_us": 10,
-                       "servo_wait_ns": 20_480_000,
+                       "servo_wait_ns": 20_992_000,
                        "reference_args": ["--sim-64bit-tables"],
                        "limits": UNO_LIMITS,
                        "job_args": "--prepare-on-host --fit 20x15 --lines 0x2 --speed 20 "

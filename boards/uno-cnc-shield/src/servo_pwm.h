@@ -20,13 +20,13 @@
 // after it, to do so; the step interrupt, the longest section with
 // interrupts masked, takes 0.16 ms at most (2 533 cycles measured).
 //
-// A pen change takes effect at the next pulse that has not begun: one that
-// comes between the gating and that pulse's BOTTOM writes OCR2A itself.
-// The hardware buffers it until BOTTOM; simavr applies it at once, but the
-// count is then past every width's compare, so neither sees a compare
-// ahead in that period. No change waits more than one pulse period,
-// 20.48 ms (24.08 ms when the gating ran at the pulse's compare and such a
-// change waited for the pulse after).
+// A pen change takes effect at the next gating: at most one pulse period
+// and the 512 us from the gating to BOTTOM, 20.99 ms (24.08 ms when the
+// gating ran at the pulse's compare). A change just after the gating is not
+// written to OCR2A for the pulse about to start: that pulse could then
+// begin under half a tick after the step the same interrupt pulsed, and the
+// recording's events would be closer than the device promises (one move or
+// pen change a tick).
 #pragma once
 
 #include <avr/io.h>
@@ -75,8 +75,7 @@ class ServoPen final : public hal::PenOutput {
   /// Call from TIMER2_COMPB_vect.
   void OnCompare() {
     // One gating a period: a compare without an overflow since the last one
-    // is the same period's again (TOV2 also tells DoSetPen() whether the
-    // gated pulse has begun).
+    // is the same period's again.
     if ((TIFR2 & _BV(TOV2)) == 0) return;
     TIFR2 = _BV(TOV2);
     if (++phase_ == kPeriodsPerPulse) phase_ = 0;
@@ -96,10 +95,6 @@ class ServoPen final : public hal::PenOutput {
   hal::IoStatus DoSetPen(bool down) override {
     widths_.set_down(down);
     next_compare_ = CompareFor(widths_.WidthUs());
-    // Gated, and the pulse's BOTTOM not passed yet (it sets TOV2, which
-    // OnCompare() cleared at the gating): this pulse can still carry it.
-    // (The count is past kGateCount, above every width's compare.)
-    if (phase_ == kPeriodsPerPulse - 1 && (TIFR2 & _BV(TOV2)) == 0) OCR2A = next_compare_;
     return hal::IoStatus::kOk;
   }
   // Also from the step interrupt (Device::Tick), before any pen change; the
